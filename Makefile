@@ -1,0 +1,35 @@
+# Two entry points: `make demo` (the main job) and `make test`. Each creates .venv and installs
+# what it needs. CI sets TORCH_SPEC=torch==2.13.0 so that pip takes the local CPU wheel before
+# anything can pull the CUDA build; ordinary users leave it empty and get torch the normal way
+# when they install the `rl` extra.
+
+PYTHON ?= python3
+VENV ?= .venv
+TORCH_SPEC ?=
+BIN := $(VENV)/bin
+
+.PHONY: demo test bench install-% lint clean
+
+# Install the package in editable mode with the given extras, once per extras set and pyproject.
+$(VENV)/.installed-%: pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	if [ -n "$(TORCH_SPEC)" ]; then $(BIN)/python -m pip install --quiet "$(TORCH_SPEC)"; fi
+	$(BIN)/python -m pip install --quiet -e ".[$*]"
+	touch $@
+
+demo: $(VENV)/.installed-render
+	$(BIN)/mdi-envs demo --output results/demo
+
+test: $(VENV)/.installed-test
+	$(BIN)/python -m pytest -q
+
+bench: $(VENV)/.installed-bench
+	$(BIN)/python -m benchmarks.solvers --output results/bench
+
+lint: $(VENV)/.installed-dev
+	$(BIN)/ruff check mdi_envs tests benchmarks
+	$(BIN)/mypy mdi_envs
+
+clean:
+	rm -rf $(VENV) results .pytest_cache .hypothesis

@@ -1,0 +1,10 @@
+"""Complementarity solvers: LCP, mixed LCP (engaged brakes) and 3-D frictional contact.
+
+This layer knows nothing of bodies, contacts or time: the stepper builds each step's problem and
+maps the solution back to impulses.
+"""
+
+from mdi_envs.solvers.lcp import LCP, LCP_METHODS, LCPResult, lcp_residual, solve_lcp
+from mdi_envs.solvers.status import SolverStatus
+
+__all__ = ["LCP", "LCPResult", "LCP_METHODS", "SolverStatus", "lcp_residual", "solve_lcp"]

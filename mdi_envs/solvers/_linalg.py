@@ -1,0 +1,68 @@
+"""Small dense linear-algebra kernels for the solvers' inner loops (numba, no exceptions).
+
+``np.linalg.solve`` raises on a singular matrix, which a compiled hot loop must not do; these
+kernels report singularity through their return value instead.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from mdi_envs._types import FloatArray
+
+
+@njit(cache=True)
+def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool:
+    """Solve ``A x = b`` by Gaussian elimination with partial pivoting, in place.
+
+    Args:
+        A: (n, n) matrix; overwritten by its LU factors.
+        b: (n,) right-hand side; overwritten by the solution x.
+        rel_pivot_tol: a pivot smaller than ``rel_pivot_tol * max|A|`` counts as singular.
+
+    Returns:
+        True on success, False if A is singular to that tolerance (A, b then hold garbage).
+    """
+    n = A.shape[0]
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            a = abs(A[i, j])
+            if a > scale:
+                scale = a
+    if n == 0:
+        return True
+    if scale == 0.0:
+        return False
+    threshold = rel_pivot_tol * scale
+    for k in range(n):
+        p = k
+        best = abs(A[k, k])
+        for i in range(k + 1, n):
+            a = abs(A[i, k])
+            if a > best:
+                best = a
+                p = i
+        if best <= threshold:
+            return False
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+            b[k], b[p] = b[p], b[k]
+        inv = 1.0 / A[k, k]
+        for i in range(k + 1, n):
+            f = A[i, k] * inv
+            if f != 0.0:
+                A[i, k] = f
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+                b[i] -= f * b[k]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= A[i, j] * b[j]
+        b[i] = s / A[i, i]
+    return True
+
+
+__all__ = ["lu_solve_inplace"]

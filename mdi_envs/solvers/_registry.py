@@ -1,0 +1,118 @@
+"""Method registries: each solver method registers itself with its options type and a summary.
+
+A driver (``solve_lcp``, ``solve_mlcp``, ``solve_fc3d``) owns one registry, looks the requested
+method up by lowercase name (as ``scipy.optimize`` does) and builds its options from keyword
+arguments, rejecting unknown names with a message that lists the valid ones.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any, Generic, TypeVar
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Options every iterative or pivoting method understands.
+
+    Attributes:
+        tol: tolerance on the problem type's shared residual measure (dimensionless).
+        max_iter: iteration limit (sweeps, Newton steps or pivots, depending on the method).
+        check_solution: recompute the shared residual after the method returns and downgrade a
+            CONVERGED status to INACCURATE when it exceeds ``tol``. Switch off only on hot paths
+            that check the solution themselves.
+    """
+
+    tol: float = 1e-10
+    max_iter: int = 1000
+    check_solution: bool = True
+
+    def __post_init__(self) -> None:
+        if not (self.tol > 0.0):
+            raise ValueError(f"option 'tol' must be > 0, got {self.tol!r}")
+        if int(self.max_iter) != self.max_iter or self.max_iter < 1:
+            raise ValueError(f"option 'max_iter' must be a positive integer, got {self.max_iter!r}")
+
+
+OptionsT = TypeVar("OptionsT", bound=SolverOptions)
+
+
+@dataclass(frozen=True)
+class MethodSpec(Generic[OptionsT]):
+    """A registered method: its solve function, options type and one-line summary."""
+
+    name: str
+    solve: Callable[..., Any]
+    options_type: type[OptionsT]
+    summary: str
+
+    def make_options(self, overrides: dict[str, Any]) -> OptionsT:
+        """Build this method's options from keyword overrides.
+
+        Raises:
+            ValueError: an option name this method does not know (the valid names are listed),
+                or an invalid option value.
+        """
+        if not overrides:
+            return self.default_options
+        valid = {f.name for f in dataclasses.fields(self.options_type)}
+        unknown = sorted(set(overrides) - valid)
+        if unknown:
+            raise ValueError(
+                f"unknown option(s) {unknown} for method {self.name!r}; "
+                f"valid options: {sorted(valid)}"
+            )
+        return self.options_type(**overrides)
+
+    @cached_property
+    def default_options(self) -> OptionsT:
+        """The method's options with every field at its default (built once)."""
+        return self.options_type()
+
+
+class MethodRegistry:
+    """Name -> method table for one problem type (e.g. ``"LCP"``)."""
+
+    def __init__(self, problem_name: str) -> None:
+        self.problem_name = problem_name
+        self._methods: dict[str, MethodSpec[Any]] = {}
+
+    def register(
+        self, name: str, options_type: type[SolverOptions], summary: str
+    ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+        """Decorator registering ``solve`` under ``name`` with its options type and summary."""
+
+        def decorator(solve: Callable[..., Any]) -> Callable[..., Any]:
+            if name in self._methods:
+                raise ValueError(f"{self.problem_name} method {name!r} registered twice")
+            self._methods[name] = MethodSpec(name, solve, options_type, summary)
+            return solve
+
+        return decorator
+
+    def lookup(self, name: str) -> MethodSpec[Any]:
+        """Return the method registered as ``name``.
+
+        Raises:
+            ValueError: no such method; the message lists the valid names.
+        """
+        try:
+            return self._methods[name]
+        except (KeyError, TypeError):
+            raise ValueError(
+                f"unknown {self.problem_name} method {name!r}; valid methods: {self.names()}"
+            ) from None
+
+    def names(self) -> list[str]:
+        """Registered method names, sorted."""
+        return sorted(self._methods)
+
+    def summaries(self) -> dict[str, str]:
+        """Method name -> one-line description."""
+        return {name: self._methods[name].summary for name in self.names()}
+
+
+__all__ = ["MethodRegistry", "MethodSpec", "SolverOptions"]
