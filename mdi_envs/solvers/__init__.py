@@ -5,6 +5,18 @@ maps the solution back to impulses.
 """
 
 from mdi_envs.solvers.lcp import LCP, LCP_METHODS, LCPResult, lcp_residual, solve_lcp
+from mdi_envs.solvers.mlcp import MLCP, MLCP_METHODS, MLCPResult, solve_mlcp
 from mdi_envs.solvers.status import SolverStatus
 
-__all__ = ["LCP", "LCPResult", "LCP_METHODS", "SolverStatus", "lcp_residual", "solve_lcp"]
+__all__ = [
+    "LCP",
+    "LCPResult",
+    "LCP_METHODS",
+    "MLCP",
+    "MLCPResult",
+    "MLCP_METHODS",
+    "SolverStatus",
+    "lcp_residual",
+    "solve_lcp",
+    "solve_mlcp",
+]

@@ -25,12 +25,12 @@ from mdi_envs.solvers._registry import SolverOptions
 from mdi_envs.solvers.lcp.problem import LCP, lcp_residual
 from mdi_envs.solvers.lcp.registry import LCP_METHODS
 from mdi_envs.solvers.status import (
-    CODE_BREAKDOWN,
     CODE_CONVERGED,
     CODE_MAX_ITER,
     CODE_RAY_TERMINATION,
     SolverStatus,
 )
+
 
 @dataclass(frozen=True)
 class LemkeOptions(SolverOptions):
@@ -262,7 +262,9 @@ def _ratio_test(
 
 
 @njit(cache=True)
-def _inverse_basis_entry(T: FloatArray, i: int, k: int, row_of: IntArray, slot_of: IntArray) -> float:
+def _inverse_basis_entry(
+    T: FloatArray, i: int, k: int, row_of: IntArray, slot_of: IntArray
+) -> float:
     """Entry (i, k) of B^-1: the tableau column of w_k, a unit vector while w_k is basic."""
     if slot_of[k] >= 0:
         return T[i, slot_of[k]]

@@ -20,9 +20,9 @@ from mdi_envs.solvers.status import (
     CODE_BREAKDOWN,
     CODE_CONVERGED,
     CODE_MAX_ITER,
-    CODE_RAY_TERMINATION,
     SolverStatus,
 )
+
 
 @dataclass(frozen=True)
 class PGSOptions(SolverOptions):

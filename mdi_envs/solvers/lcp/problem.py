@@ -20,12 +20,14 @@ from mdi_envs._types import FloatArray
 from mdi_envs.solvers.status import SolverStatus
 
 
-def as_finite_array(value: object, name: str, ndim: int) -> FloatArray:
-    """Convert ``value`` to a C-contiguous float64 array of ``ndim`` dimensions, all finite.
+def as_float_array(value: object, name: str, ndim: int) -> FloatArray:
+    """Convert ``value`` to a C-contiguous float64 array with ``ndim`` dimensions.
+
+    Finiteness is not checked here (see ``is_all_finite``).
 
     Raises:
-        ValueError: wrong number of dimensions, a non-numeric entry, or a NaN/inf entry; the
-            message names ``name``.
+        ValueError: a non-numeric entry or the wrong number of dimensions; the message names
+            ``name``.
     """
     try:
         array = np.ascontiguousarray(value, dtype=np.float64)
@@ -33,18 +35,43 @@ def as_finite_array(value: object, name: str, ndim: int) -> FloatArray:
         raise ValueError(f"{name} must be a numeric array: {error}") from None
     if array.ndim != ndim:
         raise ValueError(f"{name} must have {ndim} dimension(s), got shape {array.shape}")
-    if not _is_all_finite(array.reshape(-1)):
+    return array
+
+
+def as_finite_array(value: object, name: str, ndim: int) -> FloatArray:
+    """``as_float_array`` plus a check that every entry is finite.
+
+    Raises:
+        ValueError: as ``as_float_array``, or a NaN/inf entry; the message names ``name``.
+    """
+    array = as_float_array(value, name, ndim)
+    if not is_all_finite(array.reshape(-1)):
         raise ValueError(f"{name} contains NaN or inf entries")
     return array
 
 
 @njit(cache=True)
-def _is_all_finite(values: FloatArray) -> bool:
+def is_all_finite(values: FloatArray) -> bool:
     """Whether every entry of the flat array ``values`` is finite."""
     for v in values:
         if not np.isfinite(v):
             return False
     return True
+
+
+@njit(cache=True)
+def _screen(M: FloatArray, q: FloatArray) -> tuple[bool, bool, bool]:
+    """(M finite, q finite, q >= 0) for M (n, n), q (n,), in one compiled pass."""
+    is_trivial = True
+    for v in q:
+        if not np.isfinite(v):
+            return True, False, False
+        if v < 0.0:
+            is_trivial = False
+    for v in M.reshape(-1):
+        if not np.isfinite(v):
+            return False, True, is_trivial
+    return True, True, is_trivial
 
 
 @dataclass(frozen=True)
@@ -65,15 +92,20 @@ class LCP:
     """Whether q >= 0, so that z = 0 solves the problem (derived from q)."""
 
     def __post_init__(self) -> None:
-        M = as_finite_array(self.M, "M", 2)
-        q = as_finite_array(self.q, "q", 1)
+        M = as_float_array(self.M, "M", 2)
+        q = as_float_array(self.q, "q", 1)
         if M.shape[0] != M.shape[1]:
             raise ValueError(f"M must be square, got shape {M.shape}")
         if q.shape[0] != M.shape[0]:
             raise ValueError(f"q has length {q.shape[0]} but M is {M.shape[0]}x{M.shape[1]}")
+        is_M_finite, is_q_finite, is_trivial = _screen(M, q)
+        if not is_M_finite:
+            raise ValueError("M contains NaN or inf entries")
+        if not is_q_finite:
+            raise ValueError("q contains NaN or inf entries")
         object.__setattr__(self, "M", M)
         object.__setattr__(self, "q", q)
-        object.__setattr__(self, "is_trivial", bool(q.shape[0] == 0 or q.min() >= 0.0))
+        object.__setattr__(self, "is_trivial", is_trivial)
 
     @property
     def size(self) -> int:
@@ -132,4 +164,12 @@ def lcp_residual(M: FloatArray, q: FloatArray, z: FloatArray) -> float:
     return natural_map(M, q, z, np.empty(q.shape[0]))
 
 
-__all__ = ["LCP", "LCPResult", "as_finite_array", "lcp_residual", "natural_map"]
+__all__ = [
+    "LCP",
+    "LCPResult",
+    "as_finite_array",
+    "as_float_array",
+    "is_all_finite",
+    "lcp_residual",
+    "natural_map",
+]
