@@ -12,6 +12,7 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -79,7 +80,7 @@ def _run_demo(args: argparse.Namespace) -> int:
         for name in methods:
             if name == "enumerative" and n > 10:
                 continue
-            options = {"max_iter": 100_000} if name == "pgs" else {}
+            options: dict[str, Any] = {"max_iter": 100_000} if name == "pgs" else {}
             solve_lcp(M, q, method=name, **options)  # compile and warm up
             elapsed = np.inf
             for _ in range(5):  # best of five: the least disturbed by other processes

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +47,7 @@ def plot_complementarity(z: FloatArray, w: FloatArray, title: str, path: str | P
 
 
 def plot_time_vs_size(
-    series: dict[str, tuple[Sequence[int], Sequence[float]]],
+    series: Mapping[str, tuple[Sequence[int], Sequence[float]]],
     title: str,
     path: str | Path,
     ylabel: str = "time per solve [s]",
