@@ -1,0 +1,45 @@
+"""First-call probe: run in a fresh interpreter, prints JSON of import and first-call times.
+
+The first call of a numba kernel compiles it (or loads it from numba's on-disk cache); later
+calls do not. ``python -m benchmarks.first_call`` times, in this order: importing our LCP
+package, importing QuantEcon's Lemke, then the first call of our compiled ``lemke_solve``, of
+``solve_lcp`` for each method (which adds the driver's own compiled helpers to the first of
+them) and of QuantEcon's ``lcp_lemke``, each on the same small problem. ``timing.probe_first_calls``
+runs it with an empty or the ordinary numba cache.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import time
+from typing import Any
+
+
+def _seconds(action: Any) -> float:
+    """Wall-clock seconds of one call of ``action()``."""
+    start = time.perf_counter()
+    action()
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    """Measure and print the report as JSON on stdout."""
+    import_times = {
+        "mdi_envs.solvers.lcp": _seconds(lambda: importlib.import_module("mdi_envs.solvers.lcp")),
+        "quantecon.optimize": _seconds(lambda: importlib.import_module("quantecon.optimize")),
+    }
+    from benchmarks import entries
+    from benchmarks.problems import random_problem
+
+    problem = random_problem("spd", 5, 0)
+    probes = [entries.KERNEL] + [entries.driver_entry(m) for m in entries.LCP_METHODS]
+    probes.append(entries.QUANTECON)
+    first_call = {e.name: _seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
+    second_call = {e.name: _seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
+    report = {"import_s": import_times, "first_call_s": first_call, "second_call_s": second_call}
+    print(json.dumps(report))
+
+
+if __name__ == "__main__":
+    main()

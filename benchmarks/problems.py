@@ -1,0 +1,123 @@
+"""Benchmark problems: two seeded random LCP families and the Siconos peer LCP files.
+
+Families (every instance is reproducible from ``(SEED, family, n, instance)`` alone, so a
+problem does not depend on which grid it was generated for):
+
+* ``spd``: ``M = A A^T / n + 0.1 I`` with ``A`` standard normal, ``q ~ N(0, I)``. Symmetric
+  positive definite, so every method applies and the solution is unique.
+* ``contact``: a redundant-contact Delassus matrix. ``ceil(n / 6)`` planar rigid bodies (unit
+  mass and inertia, 3 dofs each) carry the n contacts; contact i touches body ``i mod nb`` and,
+  for odd i, also body ``i mod nb + 1`` from the other side. Each contact has a random unit
+  normal and random lever arms. ``W = J J^T`` has rank at most ``3 nb`` (about n / 2), so it is
+  regularized as constraint-force mixing does: ``M = W + 0.01 mean(diag W) I``;
+  ``q = J v`` with a free velocity ``v ~ N(0, I)``. PSD-plus-small-shift and badly conditioned,
+  as contact problems are: projected Gauss-Seidel needs about a thousand sweeps here.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mdi_envs._types import FloatArray
+from mdi_envs.solvers.siconos_io import read_lcp
+
+SEED = 20_240_601
+"""Root seed of every random benchmark problem."""
+
+CONTACTS_PER_BODY = 6
+CFM_SHIFT = 0.01
+"""Diagonal shift of the contact family, relative to the mean diagonal of ``J J^T``."""
+
+Generator = Callable[[np.random.Generator, int], tuple[FloatArray, FloatArray]]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One LCP instance of the benchmark.
+
+    Attributes:
+        name: unique label (``"spd-n20-i0"`` or the peer file's stem).
+        family: ``"spd"``, ``"contact"`` or ``"siconos"``.
+        n: size.
+        M: (n, n) C-contiguous float64 matrix.
+        q: (n,) float64 vector.
+    """
+
+    name: str
+    family: str
+    n: int
+    M: FloatArray
+    q: FloatArray
+
+
+def spd_lcp(rng: np.random.Generator, n: int) -> tuple[FloatArray, FloatArray]:
+    """Symmetric positive definite ``M = A A^T / n + 0.1 I`` and ``q ~ N(0, I)``."""
+    A = rng.standard_normal((n, n))
+    return A @ A.T / n + 0.1 * np.eye(n), rng.standard_normal(n)
+
+
+def contact_lcp(rng: np.random.Generator, n: int) -> tuple[FloatArray, FloatArray]:
+    """Regularized redundant-contact Delassus matrix and free-velocity ``q = J v``."""
+    num_bodies = math.ceil(n / CONTACTS_PER_BODY)
+    J = np.zeros((n, 3 * num_bodies))
+    for i in range(n):
+        angle = rng.uniform(0.0, 2.0 * np.pi)
+        normal = np.array([np.cos(angle), np.sin(angle)])
+        body = i % num_bodies
+        _add_contact_row(J[i], body, normal, rng.normal(0.0, 0.5, 2))
+        if i % 2 == 1 and num_bodies > 1:
+            _add_contact_row(J[i], (body + 1) % num_bodies, -normal, rng.normal(0.0, 0.5, 2))
+    W = J @ J.T
+    M = W + CFM_SHIFT * float(np.mean(np.diag(W))) * np.eye(n)
+    return M, J @ rng.standard_normal(J.shape[1])
+
+
+def _add_contact_row(row: FloatArray, body: int, normal: FloatArray, arm: FloatArray) -> None:
+    """Add a body's normal-velocity Jacobian ``(n_x, n_y, arm x n)`` to ``row`` (in place)."""
+    row[3 * body : 3 * body + 2] += normal
+    row[3 * body + 2] += arm[0] * normal[1] - arm[1] * normal[0]
+
+
+FAMILIES: dict[str, Generator] = {"spd": spd_lcp, "contact": contact_lcp}
+
+
+def random_problem(family: str, n: int, instance: int) -> Problem:
+    """Instance ``instance`` of size n of a random family (deterministic)."""
+    family_id = list(FAMILIES).index(family)
+    rng = np.random.default_rng([SEED, family_id, n, instance])
+    M, q = FAMILIES[family](rng, n)
+    return Problem(f"{family}-n{n}-i{instance}", family, n, np.ascontiguousarray(M), q)
+
+
+def peer_data_dir() -> Path:
+    """Root of the Siconos peer data: ``$MDI_ENVS_PEER_DATA`` or ``<repo>/../shared/...``."""
+    default = Path(__file__).resolve().parents[1].parent / "shared" / "peer-data" / "siconos"
+    return Path(os.environ.get("MDI_ENVS_PEER_DATA", default))
+
+
+def peer_lcp_problems(root: Path | None = None) -> list[Problem]:
+    """Every ``lcp/*.dat`` file under the peer data root, sorted by name; [] if absent."""
+    folder = (root or peer_data_dir()) / "lcp"
+    problems = []
+    for path in sorted(folder.glob("*.dat")) if folder.is_dir() else []:
+        M, q = read_lcp(path)
+        problems.append(Problem(path.stem, "siconos", q.shape[0], np.ascontiguousarray(M), q))
+    return problems
+
+
+__all__ = [
+    "FAMILIES",
+    "SEED",
+    "Problem",
+    "contact_lcp",
+    "peer_data_dir",
+    "peer_lcp_problems",
+    "random_problem",
+    "spd_lcp",
+]

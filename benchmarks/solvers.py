@@ -1,0 +1,286 @@
+"""LCP solver benchmark: work vs size for every method, and our Lemke against QuantEcon's.
+
+Usage (from the repository root; ``make bench`` runs the first line)::
+
+    python -m benchmarks.solvers --output results/bench
+    python -m benchmarks.solvers --output /tmp/bench --quick   # about 10 s, for tests
+
+Writes ``solvers.json``, ``solvers_time_vs_size.png``, ``solvers_residual_vs_size.png`` and
+``lemke_vs_quantecon.png`` to the output folder, prints progress lines on stderr and the
+Markdown results tables (the ones in ``benchmarks/README.md``) on stdout.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from benchmarks import entries as E
+from benchmarks import report
+from benchmarks.problems import (
+    FAMILIES,
+    Problem,
+    peer_data_dir,
+    peer_lcp_problems,
+    random_problem,
+)
+from benchmarks.timing import TimingPlan, machine_info, probe_first_calls, time_interleaved
+
+SIZE_STUDY_COLUMNS = (*E.LCP_METHODS, E.QUANTECON.name)
+
+
+@dataclass(frozen=True)
+class BenchConfig:
+    """Grid and timing budgets of one run.
+
+    Attributes:
+        sizes: n of the work-size study.
+        instances: random instances per (family, n) in the work-size study.
+        size_plan: timing plan per problem of the work-size study.
+        peer_sizes: n of the random problems of the QuantEcon comparison.
+        peer_plan: timing plan per problem of the QuantEcon comparison.
+        cold_compile: also measure first calls with an empty numba cache (about 30 s).
+    """
+
+    sizes: tuple[int, ...]
+    instances: int
+    size_plan: TimingPlan
+    peer_sizes: tuple[int, ...]
+    peer_plan: TimingPlan
+    cold_compile: bool
+
+
+FULL = BenchConfig(
+    sizes=(2, 3, 5, 10, 20, 50, 100, 200),
+    instances=5,
+    size_plan=TimingPlan(budget_s=0.05, min_rounds=5, max_rounds=100),
+    peer_sizes=tuple(range(10, 101, 10)),
+    peer_plan=TimingPlan(budget_s=0.25, min_rounds=9, max_rounds=400),
+    cold_compile=True,
+)
+QUICK = BenchConfig(
+    sizes=(2, 5, 10, 50),
+    instances=2,
+    size_plan=TimingPlan(budget_s=0.005, min_rounds=3, max_rounds=20),
+    peer_sizes=(10, 50, 100),
+    peer_plan=TimingPlan(budget_s=0.02, min_rounds=3, max_rounds=30),
+    cold_compile=False,
+)
+
+
+class Progress:
+    """Progress lines on stderr, stamped with the seconds since the start of the run."""
+
+    def __init__(self) -> None:
+        self.start = time.perf_counter()
+
+    @property
+    def elapsed(self) -> float:
+        """Seconds since construction."""
+        return time.perf_counter() - self.start
+
+    def __call__(self, message: str) -> None:
+        """Print one progress line."""
+        print(f"[{self.elapsed:6.1f} s] {message}", file=sys.stderr, flush=True)
+
+
+def measure_first_calls(config: BenchConfig, log: Progress) -> dict[str, Any]:
+    """First-call (compile or cache-load) times, each from a fresh interpreter."""
+    probes = {"warm_cache": False}
+    if config.cold_compile:
+        probes["cold_cache"] = True
+    results = {}
+    for label, cold in probes.items():
+        log(f"first-call probe ({label}) in a fresh interpreter ...")
+        results[label] = probe_first_calls(cold)
+        calls = results[label].get("first_call_s", {})
+        log("  " + ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in calls.items()))
+    return results
+
+
+def warm_up(all_entries: Sequence[E.Entry]) -> None:
+    """Call every entry once in this process so no timed call includes a compile or cache load."""
+    problem = random_problem("spd", 5, 0)
+    for entry in all_entries:
+        entry.solve(problem.M, problem.q)
+
+
+def time_problem(problem: Problem, chosen: Sequence[E.Entry], plan: TimingPlan) -> dict[str, Any]:
+    """Time entries on one problem in interleaved rounds and read their outcomes.
+
+    Returns:
+        entry name -> {"time": ``Timed.summary()``, "outcome": ``Outcome`` as dict}.
+    """
+    calls = {e.name: (lambda e=e: e.solve(problem.M, problem.q)) for e in chosen}
+    timed = time_interleaved(calls, plan)
+    return {
+        e.name: {
+            "time": timed[e.name].summary(),
+            "outcome": asdict(e.read(timed[e.name].result, problem.M, problem.q)),
+        }
+        for e in chosen
+    }
+
+
+def size_study(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
+    """Every method on every (family, n, instance) of the grid; one record per entry."""
+    records = []
+    for family in FAMILIES:
+        for n in config.sizes:
+            chosen = E.size_study_entries(n)
+            for instance in range(config.instances):
+                problem = random_problem(family, n, instance)
+                for name, measured in time_problem(problem, chosen, config.size_plan).items():
+                    records.append(
+                        {"family": family, "n": n, "instance": instance, "entry": name, **measured}
+                    )
+            latest = [r for r in records if r["family"] == family and r["n"] == n]
+            log(f"size study {family} n={n}: " + _progress_cells(latest))
+    return records
+
+
+def _progress_cells(records: Sequence[dict[str, Any]]) -> str:
+    """``entry median-µs`` for each entry of one (family, n), median over instances."""
+    rows = report.aggregate_size_study(records)
+    return ", ".join(f"{r['entry']} {report.format_us(r['time_median_s'])} µs" for r in rows)
+
+
+def comparison_problems(config: BenchConfig, log: Progress) -> list[Problem]:
+    """The Siconos peer LCP files (if present) and the random problems n = 10, 20, ..., 100."""
+    peers = peer_lcp_problems()
+    if peers:
+        log(f"peer data: {len(peers)} LCP files from {peer_data_dir() / 'lcp'}")
+    else:
+        log(
+            f"peer data: {peer_data_dir() / 'lcp'} absent; skipping the Siconos files "
+            "(set MDI_ENVS_PEER_DATA to the siconos folder to include them)"
+        )
+    randoms = [random_problem(f, n, 0) for f in FAMILIES for n in config.peer_sizes]
+    return peers + randoms
+
+
+def compare_with_quantecon(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
+    """Our Lemke (driver and compiled entry) against QuantEcon's, interleaved, per problem."""
+    keys = {"driver": E.DRIVER_LEMKE, "kernel": E.KERNEL, "quantecon": E.QUANTECON}
+    rows = []
+    for problem in comparison_problems(config, log):
+        measured = time_problem(problem, list(keys.values()), config.peer_plan)
+        row: dict[str, Any] = {"name": problem.name, "family": problem.family, "n": problem.n}
+        row.update({key: measured[entry.name] for key, entry in keys.items()})
+        qe_time = row["quantecon"]["time"]["median_s"]
+        row["ratio_driver"] = row["driver"]["time"]["median_s"] / qe_time
+        row["ratio_kernel"] = row["kernel"]["time"]["median_s"] / qe_time
+        rows.append(row)
+        log(
+            f"vs QuantEcon {problem.name} (n={problem.n}): driver/QE "
+            f"{report.format_ratio(row['ratio_driver'])}, lemke_solve/QE "
+            f"{report.format_ratio(row['ratio_kernel'])}; QE status "
+            f"{row['quantecon']['outcome']['status']}"
+        )
+    return rows
+
+
+def markdown_report(
+    record: dict[str, Any], aggregates: list[dict[str, Any]], summary: list[dict[str, Any]]
+) -> str:
+    """All result tables of the run, as printed to stdout and pasted into the README."""
+    machine = record["machine"]
+    first = record["first_call"]
+    lines = [
+        f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
+        f"numpy {machine['versions']['numpy']}, numba {machine['versions']['numba']}, "
+        f"quantecon {machine['versions']['quantecon']}; total {record['run_time_s']:.0f} s"
+        f"{' (--quick)' if record['config']['quick'] else ''}.",
+        "",
+        "**First call per entry** (fresh interpreter; ms):",
+        "",
+        _first_call_table(first),
+        "",
+        report.size_tables(aggregates, SIZE_STUDY_COLUMNS),
+        "",
+        "**Lemke vs QuantEcon, per problem** (median time per solve; residuals recomputed with "
+        "`lcp_residual`; our pivots/status/residual are those of `lemke_solve`, which the driver "
+        "returns unchanged)",
+        "",
+        report.peer_table(record["quantecon_comparison"]["problems"]),
+        "",
+        "**Median time ratio ours / QuantEcon** (< 1: ours faster)",
+        "",
+        report.ratio_table(summary),
+    ]
+    return "\n".join(lines)
+
+
+def _first_call_table(first: dict[str, Any]) -> str:
+    """Markdown table: entry x probe (warm / cold cache) of first-call milliseconds."""
+    probes = [p for p in first if "first_call_s" in first[p]]
+    if not probes:
+        return "(first-call probe failed: " + str(first) + ")"
+    names = list(first[probes[0]]["first_call_s"])
+    header = ["entry", *(f"first call, {p.replace('_', ' ')}" for p in probes), "second call"]
+    rows = [
+        [
+            name,
+            *(f"{first[p]['first_call_s'][name] * 1e3:.1f}" for p in probes),
+            f"{first[probes[0]]['second_call_s'][name] * 1e3:.3f}",
+        ]
+        for name in names
+    ]
+    return report._markdown(header, rows)
+
+
+def run(config: BenchConfig, output: Path, quick: bool) -> str:
+    """Run the whole benchmark, write the outputs and return the Markdown report."""
+    log = Progress()
+    output.mkdir(parents=True, exist_ok=True)
+    record: dict[str, Any] = {
+        "machine": machine_info(),
+        "config": {"quick": quick, **asdict(config)},
+    }
+    log(f"LCP solver benchmark ({'quick' if quick else 'full'}) -> {output}")
+    record["first_call"] = measure_first_calls(config, log)
+    warm_up([E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)])
+    records = size_study(config, log)
+    aggregates = report.aggregate_size_study(records)
+    record["size_study"] = {"records": records, "aggregates": aggregates}
+    rows = compare_with_quantecon(config, log)
+    summary = report.ratio_summary(rows)
+    record["quantecon_comparison"] = {
+        "quantecon_max_iter": E.QUANTECON_MAX_ITER,
+        "problems": rows,
+        "median_ratios": summary,
+    }
+    report.plot_time_vs_size(aggregates, SIZE_STUDY_COLUMNS, output / "solvers_time_vs_size.png")
+    report.plot_residual_vs_size(
+        aggregates, SIZE_STUDY_COLUMNS, output / "solvers_residual_vs_size.png"
+    )
+    report.plot_ratios(rows, output / "lemke_vs_quantecon.png")
+    record["machine"]["load_average_at_end"] = _load_average()
+    record["run_time_s"] = log.elapsed
+    report.write_json(record, output / "solvers.json")
+    log(f"done in {log.elapsed:.0f} s; wrote solvers.json and 3 plots to {output}")
+    return markdown_report(record, aggregates, summary)
+
+
+def _load_average() -> list[float] | None:
+    """The 1/5/15-minute load averages, where the platform has them."""
+    return list(os.getloadavg()) if hasattr(os, "getloadavg") else None
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
+    parser.add_argument("--quick", action="store_true", help="small grid and budgets (~10 s)")
+    args = parser.parse_args(argv)
+    print(run(QUICK if args.quick else FULL, args.output, args.quick))
+
+
+if __name__ == "__main__":
+    main()

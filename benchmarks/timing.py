@@ -1,0 +1,205 @@
+"""Wall-clock timing: interleaved rounds with adaptive repeats, first-call probes, machine info.
+
+``time_interleaved`` runs its callables in rounds A B C, A B C, ... so that a change of machine
+load (the benchmark machine is shared) hits every callable alike. Each callable first gets one
+untimed warm-up call (whose duration sizes the rest), then, per round, a batch of ``number``
+back-to-back calls long enough (``min_batch_s``) for ``time.perf_counter`` to resolve it; the
+reported time per call is the median over rounds of batch time / number.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class TimingPlan:
+    """How long to time one problem.
+
+    Attributes:
+        budget_s: target total time per callable (rounds x number x time per call).
+        min_rounds: rounds taken however slow the callables are.
+        max_rounds: rounds cap however fast they are.
+        min_batch_s: shortest batch of back-to-back calls timed as one sample.
+    """
+
+    budget_s: float
+    min_rounds: int
+    max_rounds: int
+    min_batch_s: float = 2e-4
+
+
+@dataclass(frozen=True)
+class Timed:
+    """Timing of one callable on one problem.
+
+    Attributes:
+        result: the raw return value of the untimed warm-up call.
+        median_s: median time per call over the rounds (seconds).
+        min_s: fastest time per call over the rounds.
+        q1_s, q3_s: quartiles of the time per call over the rounds.
+        rounds: number of timed samples.
+        number: calls per sample.
+    """
+
+    result: Any
+    median_s: float
+    min_s: float
+    q1_s: float
+    q3_s: float
+    rounds: int
+    number: int
+
+    def summary(self) -> dict[str, float | int]:
+        """The timing fields (not the result) as a JSON-ready dict."""
+        return {
+            "median_s": self.median_s,
+            "min_s": self.min_s,
+            "q1_s": self.q1_s,
+            "q3_s": self.q3_s,
+            "rounds": self.rounds,
+            "number": self.number,
+        }
+
+
+def _timed_call(call: Callable[[], Any]) -> tuple[Any, float]:
+    """Call once; return (result, seconds)."""
+    start = time.perf_counter()
+    result = call()
+    return result, time.perf_counter() - start
+
+
+def _batch(call: Callable[[], Any], number: int) -> float:
+    """Seconds per call of ``number`` back-to-back calls."""
+    start = time.perf_counter()
+    for _ in range(number):
+        call()
+    return (time.perf_counter() - start) / number
+
+
+def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -> dict[str, Timed]:
+    """Time several callables in interleaved rounds (see the module docstring).
+
+    Args:
+        calls: name -> zero-argument callable.
+        plan: budget and repeat limits.
+
+    Returns:
+        name -> ``Timed``, in the order of ``calls``.
+    """
+    warm = {name: _timed_call(call) for name, call in calls.items()}
+    numbers = {
+        name: max(1, math.ceil(plan.min_batch_s / max(seconds, 1e-9)))
+        for name, (_, seconds) in warm.items()
+    }
+    slowest = max(numbers[name] * warm[name][1] for name in calls)
+    rounds = min(plan.max_rounds, max(plan.min_rounds, int(plan.budget_s / max(slowest, 1e-9))))
+    samples: dict[str, list[float]] = {name: [] for name in calls}
+    for _ in range(rounds):
+        for name, call in calls.items():
+            samples[name].append(_batch(call, numbers[name]))
+    timed = {}
+    for name, values in samples.items():
+        q1, median, q3 = np.percentile(values, [25, 50, 75])
+        timed[name] = Timed(
+            warm[name][0], float(median), min(values), float(q1), float(q3), rounds, numbers[name]
+        )
+    return timed
+
+
+def probe_first_calls(cold: bool) -> dict[str, Any]:
+    """Run ``benchmarks.first_call`` in a fresh interpreter and return its JSON report.
+
+    Args:
+        cold: point ``NUMBA_CACHE_DIR`` at an empty temporary folder, so every kernel is
+            compiled from scratch (true JIT time); otherwise use the ordinary on-disk cache
+            (what a user sees from the second run on).
+
+    Returns:
+        The probe's report, or ``{"error": ...}`` if the subprocess failed.
+    """
+    env = dict(os.environ)
+    with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache_dir:
+        if cold:
+            env["NUMBA_CACHE_DIR"] = cache_dir
+        process = subprocess.run(
+            [sys.executable, "-m", "benchmarks.first_call"],
+            cwd=Path(__file__).resolve().parents[1],
+            env=env,
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+    if process.returncode != 0:
+        return {"error": process.stderr.strip().splitlines()[-1:]}
+    return json.loads(process.stdout)
+
+
+def _package_version(name: str) -> str | None:
+    """Installed version of a distribution, or None."""
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return None
+
+
+def _cpu_model() -> str:
+    """CPU model name from /proc/cpuinfo, falling back to ``platform.processor()``."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor()
+
+
+def _git_commit() -> str | None:
+    """``git rev-parse HEAD`` of the repository (read-only), or None."""
+    try:
+        process = subprocess.run(
+            ["git", "rev-parse", "HEAD"],
+            cwd=Path(__file__).resolve().parents[1],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return process.stdout.strip()
+
+
+def machine_info() -> dict[str, Any]:
+    """Platform, CPU, load, library versions and the date, for the JSON record."""
+    return {
+        "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "cpu_model": _cpu_model(),
+        "cpu_count": os.cpu_count(),
+        "cpu_affinity": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None,
+        "load_average_at_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+        "versions": {
+            name: _package_version(name)
+            for name in ("numpy", "scipy", "numba", "llvmlite", "quantecon", "mdi-envs")
+        },
+        "git_commit": _git_commit(),
+    }
+
+
+__all__ = ["Timed", "TimingPlan", "machine_info", "probe_first_calls", "time_interleaved"]
