@@ -13,6 +13,8 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, Generic, TypeVar
 
+import numpy as np
+
 
 @dataclass(frozen=True)
 class SolverOptions:
@@ -31,10 +33,40 @@ class SolverOptions:
     check_solution: bool = True
 
     def __post_init__(self) -> None:
-        if not (self.tol > 0.0):
-            raise ValueError(f"option 'tol' must be > 0, got {self.tol!r}")
-        if int(self.max_iter) != self.max_iter or self.max_iter < 1:
-            raise ValueError(f"option 'max_iter' must be a positive integer, got {self.max_iter!r}")
+        require_real_option(self, "tol", low=0.0, low_inclusive=False)
+        require_integer_option(self, "max_iter", minimum=1)
+
+
+def require_integer_option(options: object, name: str, minimum: int) -> None:
+    """Raise ValueError unless option ``name`` is an integer (not a bool) >= ``minimum``."""
+    value = getattr(options, name)
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"option {name!r} must be an integer >= {minimum}, got {value!r}")
+
+
+def require_real_option(
+    options: object,
+    name: str,
+    low: float = -np.inf,
+    high: float = np.inf,
+    low_inclusive: bool = True,
+    high_inclusive: bool = True,
+) -> None:
+    """Raise ValueError unless option ``name`` is a finite real number in the given interval."""
+    value = getattr(options, name)
+    is_real = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, bool
+    )
+    inside = is_real and bool(np.isfinite(value))
+    if inside:
+        inside = (value >= low if low_inclusive else value > low) and (
+            value <= high if high_inclusive else value < high
+        )
+    if not inside:
+        interval = (
+            f"{'[' if low_inclusive else '('}{low:g}, {high:g}{']' if high_inclusive else ')'}"
+        )
+        raise ValueError(f"option {name!r} must be a finite number in {interval}, got {value!r}")
 
 
 OptionsT = TypeVar("OptionsT", bound=SolverOptions)
@@ -94,14 +126,14 @@ class MethodRegistry:
         return decorator
 
     def lookup(self, name: str) -> MethodSpec[Any]:
-        """Return the method registered as ``name``.
+        """Return the method registered as ``name`` (case-insensitive, as in ``scipy.optimize``).
 
         Raises:
             ValueError: no such method; the message lists the valid names.
         """
         try:
-            return self._methods[name]
-        except (KeyError, TypeError):
+            return self._methods[name.lower()]
+        except (KeyError, TypeError, AttributeError):
             raise ValueError(
                 f"unknown {self.problem_name} method {name!r}; valid methods: {self.names()}"
             ) from None
@@ -115,4 +147,10 @@ class MethodRegistry:
         return {name: self._methods[name].summary for name in self.names()}
 
 
-__all__ = ["MethodRegistry", "MethodSpec", "SolverOptions"]
+__all__ = [
+    "MethodRegistry",
+    "MethodSpec",
+    "SolverOptions",
+    "require_integer_option",
+    "require_real_option",
+]

@@ -57,10 +57,18 @@ class _Reader:
         return match.group()
 
     def integer(self) -> int:
-        return int(self.token())
+        token = self.token()
+        try:
+            return int(token)
+        except ValueError:
+            raise ValueError(f"{self.source}: expected an integer, got {token!r}") from None
 
     def floats(self, count: int) -> FloatArray:
-        return np.array([float(self.token()) for _ in range(count)])
+        tokens = [self.token() for _ in range(count)]
+        try:
+            return np.array([float(token) for token in tokens])
+        except ValueError as error:
+            raise ValueError(f"{self.source}: expected {count} numbers: {error}") from None
 
     def line(self) -> str:
         end = self.text.find("\n", self.pos)
@@ -117,9 +125,14 @@ class _Reader:
             col, first, last = (int(g) for g in header.groups())
             for _ in range(last - first + 1):
                 entry = _CSPARSE_ENTRY.match(self.line())
-                if entry is None:
+                if entry is None or not (0 <= int(entry.group(1)) < rows and 0 <= col < cols):
                     raise ValueError(f"{self.source}: malformed CSparse entry in column {col}")
-                matrix[int(entry.group(1)), col] = float(entry.group(2))
+                try:
+                    matrix[int(entry.group(1)), col] = float(entry.group(2))
+                except ValueError:
+                    raise ValueError(
+                        f"{self.source}: non-numeric CSparse value in column {col}"
+                    ) from None
         return matrix
 
 

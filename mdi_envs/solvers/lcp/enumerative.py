@@ -18,10 +18,19 @@ from numba import njit
 
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers._linalg import lu_solve_inplace
-from mdi_envs.solvers._registry import SolverOptions
+from mdi_envs.solvers._registry import (
+    SolverOptions,
+    require_integer_option,
+    require_real_option,
+)
 from mdi_envs.solvers.lcp.problem import LCP
 from mdi_envs.solvers.lcp.registry import LCP_METHODS
-from mdi_envs.solvers.status import CODE_CONVERGED, CODE_NO_SOLUTION, SolverStatus
+from mdi_envs.solvers.status import (
+    CODE_CONVERGED,
+    CODE_MAX_ITER,
+    CODE_NO_SOLUTION,
+    SolverStatus,
+)
 
 
 @dataclass(frozen=True)
@@ -29,27 +38,34 @@ class EnumerativeOptions(SolverOptions):
     """Options of the enumerative method.
 
     Attributes:
+        max_iter: limit on the candidate index sets examined (the default covers n <= 24).
         max_size: largest n accepted (2^n candidates are examined in the worst case).
         feasibility_tol: a candidate's negative entries are accepted down to
             ``-feasibility_tol * max(|q|_inf, 1)``.
     """
 
+    max_iter: int = 1 << 24
     max_size: int = 12
     feasibility_tol: float = 1e-12
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        require_integer_option(self, "max_size", minimum=1)
+        require_real_option(self, "feasibility_tol", low=0.0, high=1.0)
 
 
 @njit(cache=True)
 def enumerative_kernel(
-    M: FloatArray, q: FloatArray, feasibility_tol: float, z: FloatArray
+    M: FloatArray, q: FloatArray, max_iter: int, feasibility_tol: float, z: FloatArray
 ) -> tuple[int, int]:
     """Examine complementary index sets of LCP(M, q) by increasing size.
 
     Args:
-        M: (n, n). q: (n,). feasibility_tol: see ``EnumerativeOptions``.
+        M: (n, n). q: (n,). max_iter, feasibility_tol: see ``EnumerativeOptions``.
         z: (n,) output, overwritten with the solution (zeros if none).
 
     Returns:
-        (code, candidates examined): code 0 converged, 5 no solution.
+        (code, candidates examined): code 0 converged, 1 candidate limit, 5 no solution.
     """
     n = q.shape[0]
     q_scale = 1.0
@@ -64,6 +80,10 @@ def enumerative_kernel(
         for mask in range(1 << n):
             if _popcount(mask) != size:
                 continue
+            if examined == max_iter:
+                for i in range(n):
+                    z[i] = 0.0
+                return CODE_MAX_ITER, examined
             examined += 1
             k = 0
             for i in range(n):
@@ -128,7 +148,9 @@ def solve_enumerative(
             f"max_size = {options.max_size} (use 'lemke')"
         )
     z = np.empty(problem.size)
-    code, examined = enumerative_kernel(problem.M, problem.q, options.feasibility_tol, z)
+    code, examined = enumerative_kernel(
+        problem.M, problem.q, options.max_iter, options.feasibility_tol, z
+    )
     return z, SolverStatus(code), examined
 
 

@@ -21,7 +21,7 @@ from numba import njit
 
 from mdi_envs._types import FloatArray, IntArray
 from mdi_envs.solvers._linalg import lu_solve_inplace
-from mdi_envs.solvers._registry import SolverOptions
+from mdi_envs.solvers._registry import SolverOptions, require_real_option
 from mdi_envs.solvers.lcp.problem import LCP, lcp_residual
 from mdi_envs.solvers.lcp.registry import LCP_METHODS
 from mdi_envs.solvers.status import (
@@ -51,9 +51,7 @@ class LemkeOptions(SolverOptions):
     def __post_init__(self) -> None:
         super().__post_init__()
         for name in ("pivot_tol", "tie_tol"):
-            value = getattr(self, name)
-            if not (0.0 <= value < 1.0):
-                raise ValueError(f"option {name!r} must lie in [0, 1), got {value!r}")
+            require_real_option(self, name, low=0.0, high=1.0, high_inclusive=False)
 
 
 @njit(cache=True)
@@ -98,12 +96,16 @@ def lemke_kernel(
     if qmin >= 0.0:
         return CODE_CONVERGED, 0
 
-    # Tucker tableau: basic w, non-basic z_0..z_{n-1} and the artificial in slot n.
+    # Tucker tableau: basic w, non-basic z_0..z_{n-1} and the artificial in slot n. M and q are
+    # divided by powers of two near their largest entries: exact, leaves the pivot path of
+    # exact arithmetic unchanged, and makes the tolerances independent of the data's units.
+    m_scale = _power_of_two_scale(M.reshape(-1))
+    q_scale = _power_of_two_scale(q)
     for i in range(n):
         for j in range(n):
-            T[i, j] = -M[i, j]
+            T[i, j] = -M[i, j] / m_scale
         T[i, n] = -1.0
-        T[i, rhs] = q[i]
+        T[i, rhs] = q[i] / q_scale
         basis[i] = i
         row_of[i] = i
         slot_of[i] = -1
@@ -148,8 +150,20 @@ def lemke_kernel(
     for i in range(n):
         v = basis[i]
         if n <= v < art:
-            z[v - n] = T[i, rhs]
+            z[v - n] = T[i, rhs] * (q_scale / m_scale)
     return code, num_pivots
+
+
+@njit(cache=True)
+def _power_of_two_scale(values: FloatArray) -> float:
+    """The power of two nearest max|values| (1 for an all-zero array); dividing by it is exact."""
+    largest = 0.0
+    for v in values:
+        if abs(v) > largest:
+            largest = abs(v)
+    if largest == 0.0:
+        return 1.0
+    return 2.0 ** np.round(np.log2(largest))
 
 
 @njit(cache=True)
@@ -202,32 +216,49 @@ def _ratio_test(
     if col_max == 0.0:
         return -1
     threshold = pivot_tol * col_max
-    best = -1
-    theta = np.inf
-    for i in range(n):
-        a = T[i, s]
-        if a > threshold:
-            ratio = T[i, rhs] / a
-            if ratio < theta:
-                theta = ratio
-                best = i
-    if best < 0:
-        return -1
     tie_scale = tie_tol * b_max
-    num_ties = 0
-    for i in range(n):
-        a = T[i, s]
-        if a > threshold and T[i, rhs] - theta * a <= tie_scale:
-            num_ties += 1
-    if num_ties <= 1:
-        return best
-    ties = np.empty(num_ties, dtype=np.int64)
-    num_ties = 0
-    for i in range(n):
-        a = T[i, s]
-        if a > threshold and T[i, rhs] - theta * a <= tie_scale:
-            ties[num_ties] = i
-            num_ties += 1
+    excluded = np.zeros(0, dtype=np.bool_)  # allocated only if a noise pivot must be skipped
+    while True:
+        best = -1
+        theta = np.inf
+        for i in range(n):
+            a = T[i, s]
+            if a > threshold and (excluded.shape[0] == 0 or not excluded[i]):
+                ratio = T[i, rhs] / a
+                if ratio < theta:
+                    theta = ratio
+                    best = i
+        if best < 0:
+            return -1
+        num_ties = 0
+        for i in range(n):
+            if _is_tie(T, i, s, theta, threshold, tie_scale, excluded):
+                num_ties += 1
+        ties = np.empty(max(num_ties, 1), dtype=np.int64)
+        ties[0] = best
+        num_ties = 0
+        for i in range(n):
+            if _is_tie(T, i, s, theta, threshold, tie_scale, excluded):
+                ties[num_ties] = i
+                num_ties += 1
+        num_ties = max(num_ties, 1)
+        # A pivot entry that is rounding noise relative to its own row (a zero in exact
+        # arithmetic) must not be pivoted on, nor inflate the lexicographic comparison.
+        kept = 0
+        for t in range(num_ties):
+            i = ties[t]
+            if T[i, s] > pivot_tol * _row_scale(T, i, n):
+                ties[kept] = i
+                kept += 1
+        if kept > 0:
+            num_ties = kept
+            break
+        if excluded.shape[0] == 0:
+            excluded = np.zeros(n, dtype=np.bool_)
+        for t in range(num_ties):
+            excluded[ties[t]] = True
+    if num_ties == 1:
+        return ties[0]
     art_row = -1 if slot_of[art] >= 0 else row_of[art]
     for t in range(num_ties):
         if ties[t] == art_row:
@@ -259,6 +290,34 @@ def _ratio_test(
         if num_ties == 1:
             break
     return ties[0]
+
+
+@njit(cache=True)
+def _is_tie(
+    T: FloatArray,
+    i: int,
+    s: int,
+    theta: float,
+    threshold: float,
+    tie_scale: float,
+    excluded: np.ndarray,
+) -> bool:
+    """Whether row i attains the minimum ratio theta, to the scale-relative tie tolerance."""
+    a = T[i, s]
+    if a <= threshold or (excluded.shape[0] > 0 and excluded[i]):
+        return False
+    return T[i, T.shape[1] - 1] - theta * a <= tie_scale
+
+
+@njit(cache=True)
+def _row_scale(T: FloatArray, i: int, n: int) -> float:
+    """max_c |T[i, c]| over the n + 1 non-basic slots of row i."""
+    scale = 0.0
+    for c in range(n + 1):
+        v = abs(T[i, c])
+        if v > scale:
+            scale = v
+    return scale
 
 
 @njit(cache=True)

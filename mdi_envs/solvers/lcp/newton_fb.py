@@ -18,7 +18,11 @@ from numba import njit
 
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers._linalg import lu_solve_inplace
-from mdi_envs.solvers._registry import SolverOptions
+from mdi_envs.solvers._registry import (
+    SolverOptions,
+    require_integer_option,
+    require_real_option,
+)
 from mdi_envs.solvers.lcp.problem import LCP, lcp_residual
 from mdi_envs.solvers.lcp.registry import LCP_METHODS
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_MAX_ITER, SolverStatus
@@ -40,10 +44,10 @@ class NewtonFBOptions(SolverOptions):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if not (0.0 < self.armijo < 0.5):
-            raise ValueError(f"option 'armijo' must lie in (0, 0.5), got {self.armijo!r}")
-        if self.max_backtracks < 1:
-            raise ValueError(f"option 'max_backtracks' must be >= 1, got {self.max_backtracks!r}")
+        require_real_option(
+            self, "armijo", low=0.0, high=0.5, low_inclusive=False, high_inclusive=False
+        )
+        require_integer_option(self, "max_backtracks", minimum=1)
 
 
 @njit(cache=True)

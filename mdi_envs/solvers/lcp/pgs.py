@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from mdi_envs._types import FloatArray
-from mdi_envs.solvers._registry import SolverOptions
+from mdi_envs.solvers._registry import SolverOptions, require_real_option
 from mdi_envs.solvers.lcp.problem import LCP, lcp_residual
 from mdi_envs.solvers.lcp.registry import LCP_METHODS
 from mdi_envs.solvers.status import (
@@ -40,8 +40,9 @@ class PGSOptions(SolverOptions):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if not (0.0 < self.relaxation < 2.0):
-            raise ValueError(f"option 'relaxation' must lie in (0, 2), got {self.relaxation!r}")
+        require_real_option(
+            self, "relaxation", low=0.0, high=2.0, low_inclusive=False, high_inclusive=False
+        )
 
 
 @njit(cache=True)

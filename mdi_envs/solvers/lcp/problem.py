@@ -15,12 +15,13 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers.status import SolverStatus
 
 
-def as_float_array(value: object, name: str, ndim: int) -> FloatArray:
+def as_float_array(value: ArrayLike, name: str, ndim: int) -> FloatArray:
     """Convert ``value`` to a C-contiguous float64 array with ``ndim`` dimensions.
 
     Finiteness is not checked here (see ``is_all_finite``).
@@ -30,15 +31,17 @@ def as_float_array(value: object, name: str, ndim: int) -> FloatArray:
             ``name``.
     """
     try:
+        if np.iscomplexobj(value):
+            raise ValueError("complex entries")
         array = np.ascontiguousarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"{name} must be a numeric array: {error}") from None
+    except (TypeError, ValueError, OverflowError) as error:
+        raise ValueError(f"{name} must be a numeric array of real values: {error}") from None
     if array.ndim != ndim:
         raise ValueError(f"{name} must have {ndim} dimension(s), got shape {array.shape}")
     return array
 
 
-def as_finite_array(value: object, name: str, ndim: int) -> FloatArray:
+def as_finite_array(value: ArrayLike, name: str, ndim: int) -> FloatArray:
     """``as_float_array`` plus a check that every entry is finite.
 
     Raises:
