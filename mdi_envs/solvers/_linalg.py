@@ -65,4 +65,31 @@ def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool
     return True
 
 
-__all__ = ["lu_solve_inplace"]
+
+
+@njit(cache=True)
+def invert_into(A: FloatArray, out: FloatArray, work: FloatArray, column: FloatArray) -> bool:
+    """Write A^-1 into ``out`` by one LU solve per column (for the stepper's small matrices).
+
+    Args:
+        A: (n, n) matrix (not modified).
+        out: (n, n) output, overwritten by A^-1.
+        work: (n, n) workspace. column: (n,) workspace.
+
+    Returns:
+        False if A is singular (relative pivot below 1e-14); ``out`` then holds garbage.
+    """
+    n = A.shape[0]
+    for j in range(n):
+        for r in range(n):
+            for c in range(n):
+                work[r, c] = A[r, c]
+            column[r] = 1.0 if r == j else 0.0
+        if not lu_solve_inplace(work, column, 1e-14):
+            return False
+        for r in range(n):
+            out[r, j] = column[r]
+    return True
+
+
+__all__ = ["invert_into", "lu_solve_inplace"]

@@ -99,8 +99,14 @@ def lemke_kernel(
     # Tucker tableau: basic w, non-basic z_0..z_{n-1} and the artificial in slot n. M and q are
     # divided by powers of two near their largest entries: exact, leaves the pivot path of
     # exact arithmetic unchanged, and makes the tolerances independent of the data's units.
-    m_scale = _power_of_two_scale(M.reshape(-1))
-    q_scale = _power_of_two_scale(q)
+    m_largest = 0.0
+    q_largest = 0.0
+    for i in range(n):
+        q_largest = max(q_largest, abs(q[i]))
+        for j in range(n):
+            m_largest = max(m_largest, abs(M[i, j]))
+    m_scale = _power_of_two_near(m_largest)
+    q_scale = _power_of_two_near(q_largest)
     for i in range(n):
         for j in range(n):
             T[i, j] = -M[i, j] / m_scale
@@ -155,12 +161,8 @@ def lemke_kernel(
 
 
 @njit(cache=True)
-def _power_of_two_scale(values: FloatArray) -> float:
-    """The power of two nearest max|values| (1 for an all-zero array); dividing by it is exact."""
-    largest = 0.0
-    for v in values:
-        if abs(v) > largest:
-            largest = abs(v)
+def _power_of_two_near(largest: float) -> float:
+    """The power of two nearest ``largest`` > 0 (1 for 0); dividing by it is exact."""
     if largest == 0.0:
         return 1.0
     return 2.0 ** np.round(np.log2(largest))

@@ -1,0 +1,5 @@
+"""Simulation: the Moreau-Jean midpoint stepper (single and batched)."""
+
+from mdi_envs.stepping.moreau_jean import MoreauJeanStepper, StepResult
+
+__all__ = ["MoreauJeanStepper", "StepResult"]

@@ -1,0 +1,384 @@
+"""The compiled Moreau-Jean midpoint step for one model, and its batched form.
+
+This is the one place where impulses and complementarity variables are mapped to each other
+(solvers speak ``M, q, z, w``; mechanics speaks mass matrix and coordinates). Notation of
+DESIGN.md section 2, per step of length dt:
+
+    q_M = q + dt/2 u
+    M(q_M) (u+ - u) = (h(q_M, u) + B tau) dt + W P
+    q+ = q_M + dt/2 u+
+
+with the laws on xi = W^T u+ + eps W^T u for the contacts closed at q_M (g_i(q_M) <= 0) and
+for the active brakes. Planar Coulomb friction and Tresca brakes become LCP rows by splitting
+the set-valued sign: P_R = mu P_N + P_T >= 0, P_L = mu P_N - P_T >= 0, xi_T = xi_R - xi_L
+(paper eqs. 17-21, 32-33). An ideal brake is an equality row xi_B = 0 with P_B free, eliminated
+by a Schur complement. Unknowns v = (x, y): x the LCP variables (per active contact P_N, then
+P_R and xi_L if mu > 0; per Tresca brake P_R and xi_L), y the ideal-brake impulses.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from mdi_envs.mechanics.compiled import CompiledEquations
+from mdi_envs.mechanics.models.base import ModelDefinition
+from mdi_envs.solvers._linalg import invert_into
+from mdi_envs.solvers.lcp.enumerative import enumerative_kernel
+from mdi_envs.solvers.lcp.lemke import lemke_kernel
+from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED
+
+# Layout of the per-step diagnostics vector.
+INFO_STATUS = 0  # SolverStatus code of the step's solve (CONVERGED when nothing to solve)
+INFO_ITERATIONS = 1  # pivots / candidates of the LCP solve
+INFO_ACTIVE_CONTACTS = 2  # contacts closed at the midpoint
+INFO_LCP_SIZE = 3  # complementarity variables after elimination
+INFO_EQUALITIES = 4  # ideal (equality) brake rows
+INFO_SIZE = 5
+
+# The largest LCP solved by enumeration instead of Lemke's method (2^3 candidate sets).
+DIRECT_SOLVE_MAX_SIZE = 3
+
+
+def make_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, ...]:
+    """Preallocated arrays for ``step`` of ``model``, reused across steps and batch copies."""
+    n, m = model.NUM_DOFS, model.NUM_INPUTS
+    c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
+    rows = c * d + k
+    size = 3 * c + 2 * k + k  # LCP variables (3 per contact, 2 per Tresca brake) + equalities
+    lcp = 3 * c + 2 * k
+    f = np.empty
+    return (
+        f(n), f((n, n)), f((n, n)), f(n), f((n, m)), f(n), f(c), f((c * d, n)), f((k, n)),
+        f(c), f(c), f((rows, n)), f((n, rows)), f((rows, rows)), f(rows), f(rows),
+        f((rows, size)), f(rows), f((size, size)), f(size), f((lcp, lcp)), f(lcp), f(lcp),
+        f((lcp, lcp + 2)), np.empty(lcp, np.int64), np.empty(2 * lcp + 1, np.int64),
+        np.empty(2 * lcp + 1, np.int64), np.empty(lcp + 1, np.int64), f(lcp + 2),
+        f((k, k)), f((k, k)), f((k, k)), f(k), f(size), f(rows), f((n, n)), f(n),
+        np.empty(rows, np.int64),
+    )
+
+
+def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tuple[Any, Any]:
+    """Compile ``step(...)`` and ``step_batch(...)`` for ``model`` (see their docstrings)."""
+    n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
+    c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
+    if c > 0 and d != 2:
+        raise NotImplementedError(
+            f"{model.__name__}: contact_dimension {d}; the LCP step handles planar contacts"
+        )
+    mass, forces, inputs, gaps = eq.mass, eq.forces, eq.inputs, eq.gaps
+    contact_rows, brake_rows = eq.contact_rows, eq.brake_rows
+    restitutions, friction_coefficients = eq.restitutions, eq.friction_coefficients
+
+    @njit
+    def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
+        """Advance one step of length dt [s].
+
+        Args:
+            q, u: (n,) coordinates and velocities at t_k. tau: (m,) inputs, held over the step.
+            brake_bound: (k,) brake bounds a >= 0 [force or torque]: 0 released, inf ideal.
+            dt: step [s]. p: the model's parameter record.
+            q_out, u_out: (n,) outputs at t_k + dt (overwritten).
+            impulses: (c*d + k,) output, overwritten: per contact P_N then P_T, then the
+                brake impulses [N s or N m s]; zero for open contacts and released brakes.
+            info: (INFO_SIZE,) output diagnostics (see the INFO_* constants).
+            ws: workspace from ``make_workspace``.
+        """
+        (qm, M, Minv, h, B, ufree, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree, gpre, S, s0,
+         A, a, Mred, qred, z, T, basis, row_of, slot_of, slot_var, pivot_row, Aee, Aee_inv,
+         lu_work, lu_col, v, P, Mwork, col, row_ref) = ws
+        for i in range(n):
+            qm[i] = q[i] + 0.5 * dt * u[i]
+        mass(qm, p, M)
+        forces(qm, u, p, h)
+        inputs(qm, p, B)
+        ok = invert_into(M, Minv, Mwork, col)
+        for i in range(n):
+            f = h[i]
+            for j in range(num_inputs):
+                f += B[i, j] * tau[j]
+            col[i] = f * dt
+        for i in range(n):
+            acc = u[i]
+            for j in range(n):
+                acc += Minv[i, j] * col[j]
+            ufree[i] = acc
+        for i in range(c * d + k):
+            impulses[i] = 0.0
+        info[INFO_STATUS] = CODE_CONVERGED if ok else CODE_BREAKDOWN
+        info[INFO_ITERATIONS] = 0.0
+        info[INFO_ACTIVE_CONTACTS] = 0.0
+        info[INFO_LCP_SIZE] = 0.0
+        info[INFO_EQUALITIES] = 0.0
+
+        # Active set: contacts closed at the midpoint, brakes with a positive bound.
+        gaps(qm, p, g)
+        contact_rows(qm, p, Wc)
+        brake_rows(qm, p, Wb)
+        restitutions(p, eps)
+        friction_coefficients(p, mu)
+        num_rows = 0
+        num_x = 0
+        num_eq = 0
+        num_active = 0
+        for i in range(c):
+            if g[i] <= 0.0:
+                num_active += 1
+                num_rows += 2 if mu[i] > 0.0 else 1
+                num_x += 3 if mu[i] > 0.0 else 1
+        for j in range(k):
+            if brake_bound[j] > 0.0:
+                num_rows += 1
+                if np.isinf(brake_bound[j]):
+                    num_eq += 1
+                else:
+                    num_x += 2
+        info[INFO_ACTIVE_CONTACTS] = num_active
+        if num_rows == 0 or not ok:
+            for i in range(n):
+                u_out[i] = ufree[i]
+                q_out[i] = qm[i] + 0.5 * dt * u_out[i]
+            return
+
+        # Rows W (num_rows, n), their free and pre-step velocities, and eps on normal rows.
+        r = 0
+        for i in range(c):
+            if g[i] <= 0.0:
+                for t in range(2 if mu[i] > 0.0 else 1):
+                    for j in range(n):
+                        Wr[r, j] = Wc[i * d + t, j]
+                    row_ref[r] = i * d + t
+                    r += 1
+        for b in range(k):
+            if brake_bound[b] > 0.0:
+                for j in range(n):
+                    Wr[r, j] = Wb[b, j]
+                row_ref[r] = c * d + b
+                r += 1
+        for j in range(n):
+            for r in range(num_rows):
+                acc = 0.0
+                for t in range(n):
+                    acc += Minv[j, t] * Wr[r, t]
+                MinvWt[j, r] = acc
+        for r in range(num_rows):
+            gf = 0.0
+            gp = 0.0
+            for j in range(n):
+                gf += Wr[r, j] * ufree[j]
+                gp += Wr[r, j] * u[j]
+            gfree[r] = gf
+            gpre[r] = gp
+            for s in range(num_rows):
+                acc = 0.0
+                for j in range(n):
+                    acc += Wr[r, j] * MinvWt[j, s]
+                G[r, s] = acc
+
+        # P = S v + s0 and the MLCP rows A v + a, built contact by contact (module docstring).
+        size = num_x + num_eq
+        for r in range(num_rows):
+            s0[r] = 0.0
+            for s in range(size):
+                S[r, s] = 0.0
+        for r in range(size):
+            a[r] = 0.0
+            for s in range(size):
+                A[r, s] = 0.0
+        r = 0
+        x = 0
+        y = num_x
+        for i in range(c):
+            if g[i] > 0.0:
+                continue
+            S[r, x] = 1.0
+            if mu[i] > 0.0:
+                S[r + 1, x] = -mu[i]
+                S[r + 1, x + 1] = 1.0
+                A[x + 2, x] = 2.0 * mu[i]
+                A[x + 2, x + 1] = -1.0
+                x += 3
+                r += 2
+            else:
+                x += 1
+                r += 1
+        for b in range(k):
+            bound = brake_bound[b]
+            if bound <= 0.0:
+                continue
+            if np.isinf(bound):
+                S[r, y] = 1.0
+                y += 1
+            else:
+                S[r, x] = 1.0
+                s0[r] = -bound * dt
+                x += 2
+            r += 1
+        # The rows of xi = G (S v + s0) + b, now that S and s0 are complete.
+        r = 0
+        x = 0
+        y = num_x
+        for i in range(c):
+            if g[i] > 0.0:
+                continue
+            _set_row(A, a, x, G, S, s0, gfree, gpre, r, eps[i], num_rows, size)
+            if mu[i] > 0.0:
+                _set_row(A, a, x + 1, G, S, s0, gfree, gpre, r + 1, 0.0, num_rows, size)
+                A[x + 1, x + 2] += 1.0
+                x += 3
+                r += 2
+            else:
+                x += 1
+                r += 1
+        for b in range(k):
+            bound = brake_bound[b]
+            if bound <= 0.0:
+                continue
+            if np.isinf(bound):
+                _set_row(A, a, y, G, S, s0, gfree, gpre, r, 0.0, num_rows, size)
+                y += 1
+            else:
+                _set_row(A, a, x, G, S, s0, gfree, gpre, r, 0.0, num_rows, size)
+                A[x, x + 1] += 1.0
+                A[x + 1, x] = -1.0
+                a[x + 1] = 2.0 * bound * dt
+                x += 2
+            r += 1
+
+        code, iterations = _solve_mlcp(
+            A, a, num_x, num_eq, v, Mred, qred, z, T, basis, row_of, slot_of, slot_var,
+            pivot_row, Aee, Aee_inv, lu_work, lu_col,
+        )
+        info[INFO_STATUS] = code
+        info[INFO_ITERATIONS] = iterations
+        info[INFO_LCP_SIZE] = num_x
+        info[INFO_EQUALITIES] = num_eq
+        for r in range(num_rows):
+            acc = s0[r]
+            for s in range(size):
+                acc += S[r, s] * v[s]
+            P[r] = acc
+            impulses[row_ref[r]] = acc
+        for j in range(n):
+            acc = ufree[j]
+            for r in range(num_rows):
+                acc += MinvWt[j, r] * P[r]
+            u_out[j] = acc
+            q_out[j] = qm[j] + 0.5 * dt * acc
+
+    @njit
+    def step_batch(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, ws):  # noqa: ANN001
+        """Advance N independent copies by ``num_substeps`` steps each, in place.
+
+        Args:
+            Q, U: (N, n) states, overwritten. TAU: (N, m) inputs. BRAKE: (N, k) bounds.
+            dt: step [s]. p: parameter record. num_substeps: steps per call.
+            IMPULSES: (N, c*d + k) output: the impulses of each copy's last step.
+            INFO: (N, INFO_SIZE) output: diagnostics of each copy's last step, except the status,
+                which is the worst (largest code) over the substeps.
+            ws: one workspace from ``make_workspace``, shared by the copies.
+        """
+        num_copies = Q.shape[0]
+        q_next = np.empty(n)
+        u_next = np.empty(n)
+        for e in range(num_copies):
+            worst = 0.0
+            for _ in range(num_substeps):
+                step(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e], INFO[e], ws)
+                for j in range(n):
+                    Q[e, j] = q_next[j]
+                    U[e, j] = u_next[j]
+                if INFO[e, INFO_STATUS] > worst:
+                    worst = INFO[e, INFO_STATUS]
+            INFO[e, INFO_STATUS] = worst
+
+    return step, step_batch
+
+
+@njit(cache=True)
+def _set_row(A, a, row, G, S, s0, gfree, gpre, r, eps, num_rows, size):  # noqa: ANN001
+    """A[row, :] = (G S)[r, :] and a[row] = (G s0)[r] + gfree[r] + eps gpre[r] (xi of row r)."""
+    for s in range(size):
+        acc = 0.0
+        for t in range(num_rows):
+            acc += G[r, t] * S[t, s]
+        A[row, s] = acc
+    acc = gfree[r] + eps * gpre[r]
+    for t in range(num_rows):
+        acc += G[r, t] * s0[t]
+    a[row] = acc
+
+
+@njit(cache=True)
+def _solve_mlcp(A, a, num_x, num_eq, v, Mred, qred, z, T, basis, row_of, slot_of,  # noqa: ANN001
+                slot_var, pivot_row, Aee, Aee_inv, lu_work, lu_col):
+    """Solve [x; y] from 0 <= x _|_ A_xx x + A_xy y + a_x >= 0, A_yx x + A_yy y + a_y = 0.
+
+    The equality block is eliminated (Schur complement), the reduced LCP solved by enumeration
+    when it has at most DIRECT_SOLVE_MAX_SIZE variables and by Lemke's method otherwise.
+    Writes v = (x, y); returns (status code, iterations).
+    """
+    L = num_x
+    E = num_eq
+    if E > 0:
+        for i in range(E):
+            for j in range(E):
+                Aee[i, j] = A[L + i, L + j]
+        if not invert_into(Aee[:E, :E], Aee_inv[:E, :E], lu_work[:E, :E], lu_col[:E]):
+            for i in range(L + E):
+                v[i] = 0.0
+            return CODE_BREAKDOWN, 0
+    # Reduced LCP: Mred = A_xx - A_xy Aee^-1 A_yx, qred = a_x - A_xy Aee^-1 a_y.
+    for i in range(L):
+        qi = a[i]
+        for e in range(E):
+            coef = 0.0
+            for f in range(E):
+                coef += A[i, L + f] * Aee_inv[f, e]
+            qi -= coef * a[L + e]
+            for j in range(L):
+                A[i, j] -= coef * A[L + e, j]
+        qred[i] = qi
+        for j in range(L):
+            Mred[i, j] = A[i, j]
+    code = CODE_CONVERGED
+    iterations = 0
+    if L > 0:
+        Ml = Mred[:L, :L]
+        ql = qred[:L]
+        zl = z[:L]
+        if L <= DIRECT_SOLVE_MAX_SIZE:
+            code, iterations = enumerative_kernel(Ml, ql, 1 << 24, 1e-12, zl)
+        else:
+            code, iterations = lemke_kernel(
+                Ml, ql, 100 * L + 100, 1e-12, 1e-11, T[:L, : L + 2], basis[:L],
+                row_of[: 2 * L + 1], slot_of[: 2 * L + 1], slot_var[: L + 1],
+                pivot_row[: L + 2], zl,
+            )
+    for i in range(L):
+        v[i] = z[i]
+    for e in range(E):
+        acc = 0.0
+        for f in range(E):
+            rhs = a[L + f]
+            for j in range(L):
+                rhs += A[L + f, j] * z[j]
+            acc -= Aee_inv[e, f] * rhs
+        v[L + e] = acc
+    return code, iterations
+
+
+__all__ = [
+    "DIRECT_SOLVE_MAX_SIZE",
+    "INFO_ACTIVE_CONTACTS",
+    "INFO_EQUALITIES",
+    "INFO_ITERATIONS",
+    "INFO_LCP_SIZE",
+    "INFO_SIZE",
+    "INFO_STATUS",
+    "make_step_kernels",
+    "make_workspace",
+]

@@ -1,0 +1,188 @@
+"""``MoreauJeanStepper``: the validated Python face of the compiled midpoint step.
+
+One stepper serves one model class and parameter set: ``step`` advances a single state (for
+tests, references and tooling), ``step_batch`` advances N independent copies, each with its own
+state, inputs and brake commands, in one compiled call (for vector environments).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from mdi_envs._types import FloatArray
+from mdi_envs.mechanics.compiled import compile_equations
+from mdi_envs.mechanics.models.base import ModelDefinition
+from mdi_envs.solvers.status import SolverStatus
+from mdi_envs.stepping._kernel import (
+    INFO_ACTIVE_CONTACTS,
+    INFO_EQUALITIES,
+    INFO_ITERATIONS,
+    INFO_LCP_SIZE,
+    INFO_SIZE,
+    INFO_STATUS,
+    make_step_kernels,
+    make_workspace,
+)
+
+_KERNELS: dict[type[ModelDefinition], tuple[Any, Any]] = {}
+
+
+class StepResult(NamedTuple):
+    """One step's outcome.
+
+    Attributes:
+        q: (n,) coordinates at t + dt. u: (n,) velocities at t + dt.
+        impulses: (c*d + k,) per contact P_N then P_T, then per brake P_B, over the step.
+        status: the complementarity solve's status (CONVERGED when nothing had to be solved).
+        num_iter: pivots or candidate sets of that solve.
+        num_active_contacts: contacts closed at the step's midpoint.
+        lcp_size: complementarity variables solved for. num_equalities: ideal brake rows.
+    """
+
+    q: FloatArray
+    u: FloatArray
+    impulses: FloatArray
+    status: SolverStatus
+    num_iter: int
+    num_active_contacts: int
+    lcp_size: int
+    num_equalities: int
+
+
+@dataclass
+class MoreauJeanStepper:
+    """Moreau-Jean midpoint time-stepping of one model.
+
+    Args:
+        model: the model class (a ``ModelDefinition`` subclass).
+        parameters: its parameter dataclass instance (default: ``model.Parameters()``).
+        time_step: dt [s], > 0.
+
+    Example:
+        >>> from mdi_envs.mechanics.models.bouncing_ball import BouncingBall
+        >>> stepper = MoreauJeanStepper(BouncingBall, time_step=1e-3)
+        >>> result = stepper.step([0.0, 1.0], [0.0, 0.0], [0.0])
+        >>> round(float(result.u[1]), 5)
+        -0.00981
+    """
+
+    model: type[ModelDefinition]
+    parameters: Any = None
+    time_step: float = 1e-3
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.time_step, (int, float)) and np.isfinite(self.time_step)
+                and self.time_step > 0):
+            raise ValueError(f"time_step must be a finite number > 0, got {self.time_step!r}")
+        if self.parameters is None:
+            self.parameters = self.model.Parameters()  # type: ignore[attr-defined]
+        self._values = self.parameters.values()
+        if self.model not in _KERNELS:
+            _KERNELS[self.model] = make_step_kernels(self.model, compile_equations(self.model))
+        self._step, self._step_batch = _KERNELS[self.model]
+        self._workspace = make_workspace(self.model)
+        m = self.model
+        self.num_dofs = m.NUM_DOFS
+        self.num_inputs = m.NUM_INPUTS
+        self.num_brakes = m.NUM_BRAKES
+        self.num_impulses = m.NUM_CONTACTS * m.CONTACT_DIMENSION + m.NUM_BRAKES
+
+    def step(
+        self, q: Any, u: Any, tau: Any, brake_bound: Any = None
+    ) -> StepResult:
+        """Advance one state by one step.
+
+        Args:
+            q: (n,) coordinates. u: (n,) velocities. tau: (m,) inputs.
+            brake_bound: (k,) brake bounds a >= 0 (0 released, ``np.inf`` ideal; default all
+                released).
+
+        Raises:
+            ValueError: wrong shapes, NaN/inf in q, u, tau, or a negative/NaN brake bound.
+        """
+        q_arr = self._vector(q, "q", self.num_dofs)
+        u_arr = self._vector(u, "u", self.num_dofs)
+        tau_arr = self._vector(tau, "tau", self.num_inputs)
+        brake = self._brake(brake_bound, (self.num_brakes,))
+        q_out, u_out = np.empty(self.num_dofs), np.empty(self.num_dofs)
+        impulses, info = np.empty(self.num_impulses), np.empty(INFO_SIZE)
+        self._step(q_arr, u_arr, tau_arr, brake, float(self.time_step), self._values,
+                   q_out, u_out, impulses, info, self._workspace)
+        return StepResult(
+            q_out, u_out, impulses, SolverStatus(int(info[INFO_STATUS])),
+            int(info[INFO_ITERATIONS]), int(info[INFO_ACTIVE_CONTACTS]),
+            int(info[INFO_LCP_SIZE]), int(info[INFO_EQUALITIES]),
+        )
+
+    def step_batch(
+        self,
+        q: FloatArray,
+        u: FloatArray,
+        tau: Any,
+        brake_bound: Any = None,
+        num_substeps: int = 1,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Advance N copies in place by ``num_substeps`` steps each, in one compiled call.
+
+        Args:
+            q: (N, n) float64 C-contiguous, overwritten. u: (N, n), overwritten.
+            tau: (N, m) inputs. brake_bound: (N, k) bounds (default: all released).
+            num_substeps: steps per call (>= 1).
+
+        Returns:
+            (impulses (N, c*d + k), info (N, INFO_SIZE)) of each copy's last step; the status
+            column holds the worst status over the substeps.
+
+        Raises:
+            ValueError: wrong shapes or dtypes, NaN/inf inputs, negative brake bounds.
+        """
+        for name, array in (("q", q), ("u", u)):
+            if not (isinstance(array, np.ndarray) and array.dtype == np.float64
+                    and array.flags.c_contiguous and array.ndim == 2
+                    and array.shape[1] == self.num_dofs):
+                raise ValueError(
+                    f"{name} must be a C-contiguous float64 array of shape (N, {self.num_dofs})"
+                )
+        num_copies = q.shape[0]
+        if u.shape[0] != num_copies:
+            raise ValueError(f"u has {u.shape[0]} rows, q has {num_copies}")
+        tau_arr = np.ascontiguousarray(tau, dtype=np.float64)
+        if tau_arr.shape != (num_copies, self.num_inputs) or not np.isfinite(tau_arr).all():
+            raise ValueError(
+                f"tau must be finite with shape ({num_copies}, {self.num_inputs}), "
+                f"got shape {tau_arr.shape}"
+            )
+        brake = self._brake(brake_bound, (num_copies, self.num_brakes))
+        if int(num_substeps) != num_substeps or num_substeps < 1:
+            raise ValueError(f"num_substeps must be a positive integer, got {num_substeps!r}")
+        impulses = np.empty((num_copies, self.num_impulses))
+        info = np.empty((num_copies, INFO_SIZE))
+        self._step_batch(q, u, tau_arr, brake, float(self.time_step), self._values,
+                         int(num_substeps), impulses, info, self._workspace)
+        return impulses, info
+
+    @staticmethod
+    def _vector(value: Any, name: str, size: int) -> FloatArray:
+        array = np.ascontiguousarray(value, dtype=np.float64)
+        if array.shape != (size,):
+            raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
+        if not np.isfinite(array).all():
+            raise ValueError(f"{name} contains NaN or inf entries: {array}")
+        return array
+
+    @staticmethod
+    def _brake(value: Any, shape: tuple[int, ...]) -> FloatArray:
+        if value is None:
+            return np.zeros(shape)
+        array = np.ascontiguousarray(value, dtype=np.float64)
+        if array.shape != shape:
+            raise ValueError(f"brake_bound must have shape {shape}, got {array.shape}")
+        if np.isnan(array).any() or (array < 0.0).any():
+            raise ValueError("brake_bound must be >= 0 (0 released, inf ideal), got NaN or < 0")
+        return array
+
+
+__all__ = ["MoreauJeanStepper", "StepResult"]
