@@ -18,7 +18,7 @@ P_R and xi_L if mu > 0; per Tresca brake P_R and xi_L), y the ideal-brake impuls
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -38,8 +38,25 @@ INFO_LCP_SIZE = 3  # complementarity variables after elimination
 INFO_EQUALITIES = 4  # ideal (equality) brake rows
 INFO_SIZE = 5
 
-# The largest LCP solved by enumeration instead of Lemke's method (2^3 candidate sets).
-DIRECT_SOLVE_MAX_SIZE = 3
+
+
+class StepShortcuts(NamedTuple):
+    """The exact shortcuts of the step ("skip what a scene doesn't need"), each switchable.
+
+    Each can be turned off so that tests compare it with the full path.
+
+    Attributes:
+        skip_frictionless_rows: a closed contact with mu = 0 contributes only its normal row
+            (full path: also the friction rows P_R, xi_L, which then carry P_T = 0).
+        reuse_constant_mass: for a model with HAS_CONSTANT_MASS, M^-1 is computed on the first
+            step and reused (full path: M(q_M) is evaluated and inverted every step).
+        direct_solve_max_size: LCPs up to this size are solved by exact enumeration instead of
+            Lemke's method (0: always Lemke).
+    """
+
+    skip_frictionless_rows: bool = True
+    reuse_constant_mass: bool = True
+    direct_solve_max_size: int = 3
 
 
 def make_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, ...]:
@@ -57,11 +74,13 @@ def make_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, ...]:
         f((lcp, lcp + 2)), np.empty(lcp, np.int64), np.empty(2 * lcp + 1, np.int64),
         np.empty(2 * lcp + 1, np.int64), np.empty(lcp + 1, np.int64), f(lcp + 2),
         f((k, k)), f((k, k)), f((k, k)), f(k), f(size), f(rows), f((n, n)), f(n),
-        np.empty(rows, np.int64),
+        np.empty(rows, np.int64), np.zeros(1, np.int64),
     )
 
 
-def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tuple[Any, Any]:
+def make_step_kernels(
+    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts
+) -> tuple[Any, Any]:
     """Compile ``step(...)`` and ``step_batch(...)`` for ``model`` (see their docstrings)."""
     n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
     c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
@@ -72,6 +91,9 @@ def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tu
     mass, forces, inputs, gaps = eq.mass, eq.forces, eq.inputs, eq.gaps
     contact_rows, brake_rows = eq.contact_rows, eq.brake_rows
     restitutions, friction_coefficients = eq.restitutions, eq.friction_coefficients
+    keep_frictionless_rows = not shortcuts.skip_frictionless_rows
+    reuse_mass = shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
+    direct_solve_max_size = shortcuts.direct_solve_max_size
 
     @njit
     def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
@@ -89,13 +111,16 @@ def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tu
         """
         (qm, M, Minv, h, B, ufree, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree, gpre, S, s0,
          A, a, Mred, qred, z, T, basis, row_of, slot_of, slot_var, pivot_row, Aee, Aee_inv,
-         lu_work, lu_col, v, P, Mwork, col, row_ref) = ws
+         lu_work, lu_col, v, P, Mwork, col, row_ref, mass_ready) = ws
         for i in range(n):
             qm[i] = q[i] + 0.5 * dt * u[i]
-        mass(qm, p, M)
         forces(qm, u, p, h)
         inputs(qm, p, B)
-        ok = invert_into(M, Minv, Mwork, col)
+        ok = True
+        if not (reuse_mass and mass_ready[0] == 1):
+            mass(qm, p, M)
+            ok = invert_into(M, Minv, Mwork, col)
+            mass_ready[0] = 1 if ok else 0
         for i in range(n):
             f = h[i]
             for j in range(num_inputs):
@@ -127,8 +152,8 @@ def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tu
         for i in range(c):
             if g[i] <= 0.0:
                 num_active += 1
-                num_rows += 2 if mu[i] > 0.0 else 1
-                num_x += 3 if mu[i] > 0.0 else 1
+                num_rows += 2 if mu[i] > 0.0 or keep_frictionless_rows else 1
+                num_x += 3 if mu[i] > 0.0 or keep_frictionless_rows else 1
         for j in range(k):
             if brake_bound[j] > 0.0:
                 num_rows += 1
@@ -147,7 +172,7 @@ def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tu
         r = 0
         for i in range(c):
             if g[i] <= 0.0:
-                for t in range(2 if mu[i] > 0.0 else 1):
+                for t in range(2 if mu[i] > 0.0 or keep_frictionless_rows else 1):
                     for j in range(n):
                         Wr[r, j] = Wc[i * d + t, j]
                     row_ref[r] = i * d + t
@@ -195,7 +220,7 @@ def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tu
             if g[i] > 0.0:
                 continue
             S[r, x] = 1.0
-            if mu[i] > 0.0:
+            if mu[i] > 0.0 or keep_frictionless_rows:
                 S[r + 1, x] = -mu[i]
                 S[r + 1, x + 1] = 1.0
                 A[x + 2, x] = 2.0 * mu[i]
@@ -225,7 +250,7 @@ def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tu
             if g[i] > 0.0:
                 continue
             _set_row(A, a, x, G, S, s0, gfree, gpre, r, eps[i], num_rows, size)
-            if mu[i] > 0.0:
+            if mu[i] > 0.0 or keep_frictionless_rows:
                 _set_row(A, a, x + 1, G, S, s0, gfree, gpre, r + 1, 0.0, num_rows, size)
                 A[x + 1, x + 2] += 1.0
                 x += 3
@@ -249,8 +274,8 @@ def make_step_kernels(model: type[ModelDefinition], eq: CompiledEquations) -> tu
             r += 1
 
         code, iterations = _solve_mlcp(
-            A, a, num_x, num_eq, v, Mred, qred, z, T, basis, row_of, slot_of, slot_var,
-            pivot_row, Aee, Aee_inv, lu_work, lu_col,
+            A, a, num_x, num_eq, direct_solve_max_size, v, Mred, qred, z, T, basis, row_of,
+            slot_of, slot_var, pivot_row, Aee, Aee_inv, lu_work, lu_col,
         )
         info[INFO_STATUS] = code
         info[INFO_ITERATIONS] = iterations
@@ -313,12 +338,12 @@ def _set_row(A, a, row, G, S, s0, gfree, gpre, r, eps, num_rows, size):  # noqa:
 
 
 @njit(cache=True)
-def _solve_mlcp(A, a, num_x, num_eq, v, Mred, qred, z, T, basis, row_of, slot_of,  # noqa: ANN001
-                slot_var, pivot_row, Aee, Aee_inv, lu_work, lu_col):
+def _solve_mlcp(A, a, num_x, num_eq, direct_solve_max_size, v, Mred, qred, z, T,  # noqa: ANN001
+                basis, row_of, slot_of, slot_var, pivot_row, Aee, Aee_inv, lu_work, lu_col):
     """Solve [x; y] from 0 <= x _|_ A_xx x + A_xy y + a_x >= 0, A_yx x + A_yy y + a_y = 0.
 
     The equality block is eliminated (Schur complement), the reduced LCP solved by enumeration
-    when it has at most DIRECT_SOLVE_MAX_SIZE variables and by Lemke's method otherwise.
+    when it has at most ``direct_solve_max_size`` variables and by Lemke's method otherwise.
     Writes v = (x, y); returns (status code, iterations).
     """
     L = num_x
@@ -350,7 +375,7 @@ def _solve_mlcp(A, a, num_x, num_eq, v, Mred, qred, z, T, basis, row_of, slot_of
         Ml = Mred[:L, :L]
         ql = qred[:L]
         zl = z[:L]
-        if L <= DIRECT_SOLVE_MAX_SIZE:
+        if L <= direct_solve_max_size:
             code, iterations = enumerative_kernel(Ml, ql, 1 << 24, 1e-12, zl)
         else:
             code, iterations = lemke_kernel(
@@ -372,13 +397,13 @@ def _solve_mlcp(A, a, num_x, num_eq, v, Mred, qred, z, T, basis, row_of, slot_of
 
 
 __all__ = [
-    "DIRECT_SOLVE_MAX_SIZE",
     "INFO_ACTIVE_CONTACTS",
     "INFO_EQUALITIES",
     "INFO_ITERATIONS",
     "INFO_LCP_SIZE",
     "INFO_SIZE",
     "INFO_STATUS",
+    "StepShortcuts",
     "make_step_kernels",
     "make_workspace",
 ]

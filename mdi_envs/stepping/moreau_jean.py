@@ -23,11 +23,12 @@ from mdi_envs.stepping._kernel import (
     INFO_LCP_SIZE,
     INFO_SIZE,
     INFO_STATUS,
+    StepShortcuts,
     make_step_kernels,
     make_workspace,
 )
 
-_KERNELS: dict[type[ModelDefinition], tuple[Any, Any]] = {}
+_KERNELS: dict[tuple[type[ModelDefinition], StepShortcuts], tuple[Any, Any]] = {}
 
 
 class StepResult(NamedTuple):
@@ -60,6 +61,7 @@ class MoreauJeanStepper:
         model: the model class (a ``ModelDefinition`` subclass).
         parameters: its parameter dataclass instance (default: ``model.Parameters()``).
         time_step: dt [s], > 0.
+        shortcuts: which exact shortcuts to take (default: all; see ``StepShortcuts``).
 
     Example:
         >>> from mdi_envs.mechanics.models.bouncing_ball import BouncingBall
@@ -72,6 +74,7 @@ class MoreauJeanStepper:
     model: type[ModelDefinition]
     parameters: Any = None
     time_step: float = 1e-3
+    shortcuts: StepShortcuts = StepShortcuts()
 
     def __post_init__(self) -> None:
         if not (isinstance(self.time_step, (int, float)) and np.isfinite(self.time_step)
@@ -80,9 +83,12 @@ class MoreauJeanStepper:
         if self.parameters is None:
             self.parameters = self.model.Parameters()  # type: ignore[attr-defined]
         self._values = self.parameters.values()
-        if self.model not in _KERNELS:
-            _KERNELS[self.model] = make_step_kernels(self.model, compile_equations(self.model))
-        self._step, self._step_batch = _KERNELS[self.model]
+        key = (self.model, self.shortcuts)
+        if key not in _KERNELS:
+            _KERNELS[key] = make_step_kernels(
+                self.model, compile_equations(self.model), self.shortcuts
+            )
+        self._step, self._step_batch = _KERNELS[key]
         self._workspace = make_workspace(self.model)
         m = self.model
         self.num_dofs = m.NUM_DOFS
