@@ -4,11 +4,21 @@ This layer knows nothing of bodies, contacts or time: the stepper builds each st
 maps the solution back to impulses.
 """
 
+from mdi_envs.solvers.fc3d import (
+    FC3D_METHODS,
+    FC3DResult,
+    FrictionContact3D,
+    fc3d_residual,
+    solve_fc3d,
+)
 from mdi_envs.solvers.lcp import LCP, LCP_METHODS, LCPResult, lcp_residual, solve_lcp
 from mdi_envs.solvers.mlcp import MLCP, MLCP_METHODS, MLCPResult, solve_mlcp
 from mdi_envs.solvers.status import SolverStatus
 
 __all__ = [
+    "FC3DResult",
+    "FC3D_METHODS",
+    "FrictionContact3D",
     "LCP",
     "LCPResult",
     "LCP_METHODS",
@@ -16,7 +26,9 @@ __all__ = [
     "MLCPResult",
     "MLCP_METHODS",
     "SolverStatus",
+    "fc3d_residual",
     "lcp_residual",
+    "solve_fc3d",
     "solve_lcp",
     "solve_mlcp",
 ]

@@ -9,9 +9,9 @@ r_i = (r_N, r_T) and u_i = (u_N, u_T) the rows 3i (normal), 3i+1 and 3i+2 (tange
     K_mu* = {y : mu ||y_T|| <= y_N}                 (its dual cone)
     u_hat_i = u_i + (mu_i ||u_T||, 0, 0)            (De Saxce's modified velocity)
 
-    K_mu ∋ r_i  ⊥  u_hat_i ∈ K_mu*.
+    r_i in K_mu,   u_hat_i in K_mu*,   r_i . u_hat_i = 0.
 
-This is equivalent to Signorini's condition ``0 <= u_N ⊥ r_N >= 0`` together with Coulomb's law:
+This is equivalent to Signorini's condition ``0 <= u_N  _|_  r_N >= 0`` and Coulomb's law:
 ``u_T = 0`` and ``||r_T|| <= mu r_N`` (stick) or ``r_T = -mu r_N u_T / ||u_T||`` (slide).
 
 Residual (dimensionless), judged the same way for every method:
@@ -164,7 +164,9 @@ def residual_from_velocity(q: FloatArray, mu: FloatArray, r: FloatArray, u: Floa
 
 
 @njit(cache=True)
-def natural_map(W: FloatArray, q: FloatArray, mu: FloatArray, r: FloatArray, u: FloatArray) -> float:
+def natural_map(
+    W: FloatArray, q: FloatArray, mu: FloatArray, r: FloatArray, u: FloatArray
+) -> float:
     """Fill u (3 nc,) with W r + q and return the shared residual of r (3 nc,)."""
     compute_velocity(W, q, r, u)
     return residual_from_velocity(q, mu, r, u)

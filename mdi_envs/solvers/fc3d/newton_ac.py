@@ -1,0 +1,502 @@
+"""Global semismooth Newton on the Alart-Curnier function: line search, proximal safeguard.
+
+Per contact i, with u = W r + q and a weight rho_i > 0, the Alart-Curnier function is
+
+    a_N = r_N - rho u_N,                 a_T = r_T - rho u_T,
+    phi_N = r_N - max(0, a_N),
+    phi_T = r_T - P_D(R)(a_T),           R = mu max(0, a_N),
+
+where P_D(R) projects onto the disk of radius R. phi = 0 exactly at the solutions of the FC3D
+problem (Alart & Curnier, 1991). phi is piecewise smooth in (r, u); on each piece
+
+    d phi_i = A_i dr_i + B_i du_i,       du_i = W_i. dr,
+
+so an element of the generalized Jacobian is ``J = blockdiag(A) + blockrows(B) W``
+(``alart_curnier_local`` computes phi_i, A_i and B_i of one contact; both this method and the
+Gauss-Seidel method call it). Each step solves ``J d = -phi`` by LU with partial pivoting and
+backtracks on the merit function ``psi = |phi|^2 / 2`` (Armijo). When J is singular to working
+precision or the Newton direction is not a descent direction, the step is a
+Levenberg-Marquardt step ``(J^T J + lambda I) d = -J^T phi`` with lambda proportional to |phi|,
+and failing that the steepest-descent direction ``-J^T phi``.
+
+Redundant contacts make W (hence J) singular, and plain Newton then crawls (tiny accepted
+steps) or stalls. After the first such poor step the method switches to proximal-point
+iterations: Newton steps on the regularised problem FC3D(W + sigma D, q - sigma D c),
+D = blockdiag(I / rho_i), whose solution is the proximal point of the centre c. The
+regularised Jacobian ``J + sigma blockdiag(B_i / rho_i)`` is regular where J is not; its
+velocity equals W r + q at r = c, so every fixed point is a solution of the original problem.
+The centre moves to the iterate once the sub-problem's AC norm has dropped to a fraction of
+the original AC norm at the centre; sigma shrinks tenfold when that took at most two steps and
+improved the original AC norm, and grows tenfold on every poor step. A sigma beyond 1e8 is
+reported as BREAKDOWN (as is a failed line search when ``prox_sigma = 0`` disables the
+regularisation), the step limit as MAX_ITER. Convergence is always judged on the shared
+residual of the original problem.
+
+rho_i = 1 / ||W_ii||_F (the Frobenius norm of contact i's diagonal 3x3 block) makes the
+two arguments of each projection commensurate; ``rho_scale`` multiplies it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from mdi_envs._types import FloatArray
+from mdi_envs.solvers._linalg import lu_solve_inplace
+from mdi_envs.solvers._registry import (
+    SolverOptions,
+    require_integer_option,
+    require_real_option,
+)
+from mdi_envs.solvers.fc3d.problem import (
+    FrictionContact3D,
+    compute_velocity,
+    residual_from_velocity,
+)
+from mdi_envs.solvers.fc3d.registry import FC3D_METHODS
+from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_MAX_ITER, SolverStatus
+
+_PIVOT_TOL = 1e-14
+"""Relative pivot tolerance below which the Newton matrix counts as singular."""
+_SLOW_STEP = 1.0 / 32.0
+"""A step length below this counts as a poor step: regularise (more)."""
+_PROX_ETA = 0.5
+"""A proximal sub-problem counts as solved at this fraction of the AC norm at its centre."""
+_PROX_DECREASE = 0.1
+_MAX_SUB_STEPS = 10
+"""Newton steps on one proximal sub-problem before sigma is increased."""
+_PROX_INCREASE = 10.0
+_PROX_SIGMA_MAX = 1e8
+"""Largest proximal weight (relative to ||W_ii||) before the method reports a breakdown."""
+
+Workspace = tuple[FloatArray, ...]
+"""Scratch arrays of ``newton_ac_core`` (see ``make_workspace``)."""
+
+
+@dataclass(frozen=True)
+class NewtonACOptions(SolverOptions):
+    """Options of the Alart-Curnier Newton method.
+
+    Attributes:
+        max_iter: Newton step limit.
+        armijo: sufficient-decrease constant sigma of the line search, in (0, 1/2).
+        max_backtracks: step halvings before the line search is declared failed (BREAKDOWN).
+        rho_scale: factor on the per-contact weight rho_i = 1 / ||W_ii||_F, > 0.
+        prox_sigma: initial proximal weight sigma (relative to ||W_ii||) once plain Newton
+            steps stall; 0 disables the proximal regularisation.
+    """
+
+    max_iter: int = 100
+    armijo: float = 1e-4
+    max_backtracks: int = 40
+    rho_scale: float = 1.0
+    prox_sigma: float = 1.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        require_real_option(
+            self, "armijo", low=0.0, high=0.5, low_inclusive=False, high_inclusive=False
+        )
+        require_integer_option(self, "max_backtracks", minimum=1)
+        require_real_option(self, "rho_scale", low=0.0, low_inclusive=False)
+        require_real_option(self, "prox_sigma", low=0.0)
+
+
+@njit(cache=True)
+def contact_weights(W: FloatArray, rho_scale: float) -> FloatArray:
+    """rho_i = rho_scale / ||W_ii||_F per contact (W (3 nc, 3 nc)); 1 / max|W| for a zero block.
+
+    Returns:
+        (nc,) array of positive weights.
+    """
+    nc = W.shape[0] // 3
+    rho = np.empty(nc)
+    w_max = 0.0
+    for v in W.reshape(-1):
+        w_max = max(w_max, abs(v))
+    fallback = 1.0 / w_max if w_max > 0.0 else 1.0
+    for i in range(nc):
+        k = 3 * i
+        acc = 0.0
+        for a in range(3):
+            for b in range(3):
+                acc += W[k + a, k + b] * W[k + a, k + b]
+        rho[i] = rho_scale * (1.0 / np.sqrt(acc) if acc > 0.0 else fallback)
+    return rho
+
+
+@njit(cache=True)
+def alart_curnier_local(
+    rho: float,
+    mu: float,
+    r: FloatArray,
+    u: FloatArray,
+    phi: FloatArray,
+    A: FloatArray,
+    B: FloatArray,
+    with_jacobian: bool,
+) -> None:
+    """The Alart-Curnier function of one contact and the blocks of a generalized Jacobian.
+
+    Args:
+        rho: weight > 0. mu: friction coefficient >= 0.
+        r: (3,) impulse (normal, tangent 1, tangent 2). u: (3,) velocity W r + q of the contact.
+        phi: (3,) output, the function value (modified in place).
+        A, B: (3, 3) outputs, ``d phi = A dr + B du`` on the current piece (modified in place
+            when ``with_jacobian``).
+        with_jacobian: whether to fill A and B.
+    """
+    a_n = r[0] - rho * u[0]
+    a_t1 = r[1] - rho * u[1]
+    a_t2 = r[2] - rho * u[2]
+    if with_jacobian:
+        for a in range(3):
+            for b in range(3):
+                A[a, b] = 0.0
+                B[a, b] = 0.0
+    if a_n > 0.0:  # normal impulse active: phi_N = rho u_N
+        phi[0] = rho * u[0]
+        radius = mu * a_n
+        if with_jacobian:
+            B[0, 0] = rho
+    else:  # separation: phi_N = r_N
+        phi[0] = r[0]
+        radius = 0.0
+        if with_jacobian:
+            A[0, 0] = 1.0
+    norm_t = np.sqrt(a_t1 * a_t1 + a_t2 * a_t2)
+    if radius > 0.0 and norm_t <= radius:  # stick: phi_T = rho u_T
+        phi[1] = rho * u[1]
+        phi[2] = rho * u[2]
+        if with_jacobian:
+            B[1, 1] = rho
+            B[2, 2] = rho
+        return
+    # slide (or no normal impulse): phi_T = r_T - R n, n = a_T / |a_T|
+    if norm_t > 0.0:
+        n1 = a_t1 / norm_t
+        n2 = a_t2 / norm_t
+        s = radius / norm_t
+    else:
+        n1 = 0.0
+        n2 = 0.0
+        s = 0.0
+    phi[1] = r[1] - radius * n1
+    phi[2] = r[2] - radius * n2
+    if not with_jacobian:
+        return
+    # d(R n) = n mu H(a_N) da_N + s (I - n n^T) da_T, with da = dr - rho du
+    h1 = mu * n1 if a_n > 0.0 else 0.0
+    h2 = mu * n2 if a_n > 0.0 else 0.0
+    p11 = s * (1.0 - n1 * n1)
+    p12 = -s * n1 * n2
+    p22 = s * (1.0 - n2 * n2)
+    A[1, 0] = -h1
+    A[2, 0] = -h2
+    A[1, 1] = 1.0 - p11
+    A[1, 2] = -p12
+    A[2, 1] = -p12
+    A[2, 2] = 1.0 - p22
+    B[1, 0] = rho * h1
+    B[2, 0] = rho * h2
+    B[1, 1] = rho * p11
+    B[1, 2] = rho * p12
+    B[2, 1] = rho * p12
+    B[2, 2] = rho * p22
+
+
+@njit(cache=True)
+def alart_curnier(
+    mu: FloatArray,
+    rho: FloatArray,
+    r: FloatArray,
+    u: FloatArray,
+    phi: FloatArray,
+    A: FloatArray,
+    B: FloatArray,
+    with_jacobian: bool,
+) -> float:
+    """Stack ``alart_curnier_local`` over all contacts; return the merit ``|phi|^2 / 2``.
+
+    Args:
+        mu, rho: (nc,). r, u: (3 nc,). phi: (3 nc,) output.
+        A, B: (nc, 3, 3) outputs, filled when ``with_jacobian``.
+    """
+    psi = 0.0
+    for i in range(mu.shape[0]):
+        k = 3 * i
+        phi_i = phi[k : k + 3]
+        alart_curnier_local(
+            rho[i], mu[i], r[k : k + 3], u[k : k + 3], phi_i, A[i], B[i], with_jacobian
+        )
+        psi += 0.5 * (phi_i[0] * phi_i[0] + phi_i[1] * phi_i[1] + phi_i[2] * phi_i[2])
+    return psi
+
+
+@njit(cache=True)
+def make_workspace(n: int) -> Workspace:
+    """Scratch arrays of ``newton_ac_core`` for a problem of size n = 3 nc."""
+    nc = n // 3
+    return (
+        np.empty(n),  # u = W r + q
+        np.empty(n),  # velocity of the proximal sub-problem
+        np.empty(n),  # proximal centre
+        np.empty(n),  # phi
+        np.empty((nc, 3, 3)),  # A
+        np.empty((nc, 3, 3)),  # B
+        np.empty((n, n)),  # J
+        np.empty((n, n)),  # factored copy of J (or of J^T J + lambda I)
+        np.empty(n),  # d
+        np.empty(n),  # grad = J^T phi
+        np.empty(n),  # (W + sigma D) d
+        np.empty(n),  # trial r
+        np.empty(n),  # trial u
+        np.empty(n),  # trial phi
+    )
+
+
+@njit(cache=True)
+def _assemble_jacobian(
+    W: FloatArray, A: FloatArray, B: FloatArray, sigma: float, rho: FloatArray, J: FloatArray
+) -> None:
+    """J = blockdiag(A) + blockrows(B) (W + sigma D), D = blockdiag(I / rho_i).
+
+    Args:
+        W, J: (n, n); J is the output. A, B: (nc, 3, 3). sigma: >= 0. rho: (nc,).
+    """
+    n = W.shape[0]
+    for i in range(n // 3):
+        k = 3 * i
+        shift = sigma / rho[i]
+        for a in range(3):
+            row = k + a
+            b0 = B[i, a, 0]
+            b1 = B[i, a, 1]
+            b2 = B[i, a, 2]
+            for j in range(n):
+                J[row, j] = b0 * W[k, j] + b1 * W[k + 1, j] + b2 * W[k + 2, j]
+            for c in range(3):
+                J[row, k + c] += A[i, a, c] + shift * B[i, a, c]
+
+
+@njit(cache=True)
+def _levenberg_marquardt_step(
+    J: FloatArray, grad: FloatArray, phi_norm: float, H: FloatArray, d: FloatArray
+) -> bool:
+    """Levenberg-Marquardt step ``d = -(J^T J + lambda I)^-1 grad``; False if singular.
+
+    lambda = min(phi_norm, 1) * mean(diag J^T J); H (n, n) is scratch, d (n,) the output.
+    """
+    n = J.shape[0]
+    for a in range(n):
+        for b in range(a, n):
+            acc = 0.0
+            for k in range(n):
+                acc += J[k, a] * J[k, b]
+            H[a, b] = acc
+            H[b, a] = acc
+    trace = 0.0
+    for a in range(n):
+        trace += H[a, a]
+    lam = (min(phi_norm, 1.0) + 1e-12) * max(trace / n, 1e-300)
+    for a in range(n):
+        H[a, a] += lam
+        d[a] = -grad[a]
+    return lu_solve_inplace(H, d, _PIVOT_TOL)
+
+
+@njit(cache=True)
+def _search_direction(
+    J: FloatArray, phi: FloatArray, psi: float, H: FloatArray, d: FloatArray, grad: FloatArray
+) -> tuple[float, bool]:
+    """Fill d with a descent direction of psi = |phi|^2 / 2.
+
+    Newton (``J d = -phi``) if J is regular and that is a descent direction, else
+    Levenberg-Marquardt, else steepest descent.
+
+    Returns:
+        (slope, is_newton): the slope grad . d (0 when grad = J^T phi = 0) and whether d is the
+        Newton direction.
+    """
+    n = J.shape[0]
+    g_norm2 = 0.0
+    for j in range(n):
+        acc = 0.0
+        for i in range(n):
+            acc += J[i, j] * phi[i]
+        grad[j] = acc
+        g_norm2 += acc * acc
+    if g_norm2 == 0.0:
+        return 0.0, False
+    for i in range(n):
+        for j in range(n):
+            H[i, j] = J[i, j]
+        d[i] = -phi[i]
+    if lu_solve_inplace(H, d, _PIVOT_TOL):
+        slope = 0.0
+        d_norm2 = 0.0
+        for i in range(n):
+            slope += grad[i] * d[i]
+            d_norm2 += d[i] * d[i]
+        if np.isfinite(slope) and slope < -1e-12 * np.sqrt(d_norm2 * g_norm2):
+            return slope, True
+    if _levenberg_marquardt_step(J, grad, np.sqrt(2.0 * psi), H, d):
+        slope = 0.0
+        for i in range(n):
+            slope += grad[i] * d[i]
+        if np.isfinite(slope) and slope < 0.0:
+            return slope, False
+    for i in range(n):
+        d[i] = -grad[i]
+    return -g_norm2, False
+
+
+@njit(cache=True)
+def newton_ac_core(
+    W: FloatArray,
+    q: FloatArray,
+    mu: FloatArray,
+    rho: FloatArray,
+    r: FloatArray,
+    max_iter: int,
+    tol: float,
+    armijo: float,
+    max_backtracks: int,
+    prox_sigma: float,
+    workspace: Workspace,
+) -> tuple[int, int, float]:
+    """Semismooth Newton iterations on the Alart-Curnier function of FC3D(W, q, mu).
+
+    Plain Newton steps until a poor one (line search failed, not a Newton direction, or step
+    length below ``_SLOW_STEP``); from then on proximal-point steps as described in the module
+    docstring, where a step is poor if its line search failed, it is not a Newton direction,
+    or the sub-problem is still unsolved after ``_MAX_SUB_STEPS`` steps.
+
+    Args:
+        W: (n, n), n = 3 nc. q: (n,). mu, rho: (nc,).
+        r: (n,) starting point, overwritten by the iterate (modified in place).
+        max_iter, tol, armijo, max_backtracks, prox_sigma: see ``NewtonACOptions``.
+        workspace: ``make_workspace(n)``.
+
+    Returns:
+        (code, steps, residual): code 0 converged (shared residual <= tol), 1 step limit,
+        3 breakdown (no progress even with sigma at ``_PROX_SIGMA_MAX``, or with
+        ``prox_sigma = 0`` a failed line search); the shared residual of the returned r.
+    """
+    u, u_sub, center, phi, A, B, J, H, d, grad, Wd, trial_r, trial_u, trial_phi = workspace
+    n = q.shape[0]
+    sigma = 0.0
+    center_norm = 0.0
+    sub_steps = 0
+    compute_velocity(W, q, r, u)
+    for step in range(max_iter + 1):
+        residual = residual_from_velocity(q, mu, r, u)
+        if residual <= tol:
+            return CODE_CONVERGED, step, residual
+        if step == max_iter:
+            break
+        for i in range(n):
+            u_sub[i] = u[i] + sigma * (r[i] - center[i]) / rho[i // 3] if sigma > 0.0 else u[i]
+        psi = alart_curnier(mu, rho, r, u_sub, phi, A, B, True)
+        if sigma > 0.0 and sub_steps > 0 and np.sqrt(2.0 * psi) <= _PROX_ETA * center_norm:
+            # the sub-problem is solved well enough: move the centre to r
+            psi = alart_curnier(mu, rho, r, u, phi, A, B, True)
+            if sub_steps <= 2 and np.sqrt(2.0 * psi) < center_norm:
+                sigma *= _PROX_DECREASE
+            for i in range(n):
+                center[i] = r[i]
+                u_sub[i] = u[i]
+            center_norm = np.sqrt(2.0 * psi)
+            sub_steps = 0
+        _assemble_jacobian(W, A, B, sigma, rho, J)
+        slope, is_newton = _search_direction(J, phi, psi, H, d, grad)
+        for i in range(n):
+            acc = sigma * d[i] / rho[i // 3]
+            for j in range(n):
+                acc += W[i, j] * d[j]
+            Wd[i] = acc
+        t = 1.0
+        accepted = False
+        if slope < 0.0:
+            for _ in range(max_backtracks):
+                for i in range(n):
+                    trial_r[i] = r[i] + t * d[i]
+                    trial_u[i] = u_sub[i] + t * Wd[i]
+                trial_psi = alart_curnier(mu, rho, trial_r, trial_u, trial_phi, A, B, False)
+                if trial_psi <= psi + armijo * t * slope:
+                    accepted = True
+                    break
+                t *= 0.5
+        if accepted:
+            for i in range(n):
+                r[i] = trial_r[i]
+            compute_velocity(W, q, r, u)  # fresh, not u + t W d: no accumulated rounding
+            sub_steps += 1
+        if sigma == 0.0:
+            is_poor = not accepted or not is_newton or t < _SLOW_STEP
+        else:
+            is_poor = not accepted or not is_newton or sub_steps >= _MAX_SUB_STEPS
+        if is_poor:
+            if prox_sigma <= 0.0:
+                if accepted:
+                    continue
+                return CODE_BREAKDOWN, step, residual
+            sigma = prox_sigma if sigma == 0.0 else sigma * _PROX_INCREASE
+            if sigma > _PROX_SIGMA_MAX:
+                return CODE_BREAKDOWN, step + 1, residual_from_velocity(q, mu, r, u)
+            for i in range(n):
+                center[i] = r[i]
+            center_norm = np.sqrt(2.0 * alart_curnier(mu, rho, r, u, trial_phi, A, B, False))
+            sub_steps = 0
+    return CODE_MAX_ITER, max_iter, residual
+
+
+@njit(cache=True)
+def newton_ac_kernel(
+    W: FloatArray,
+    q: FloatArray,
+    mu: FloatArray,
+    r: FloatArray,
+    max_iter: int,
+    tol: float,
+    armijo: float,
+    max_backtracks: int,
+    rho_scale: float,
+    prox_sigma: float,
+) -> tuple[int, int, float]:
+    """``newton_ac_core`` with the default weights and a fresh workspace (same arguments)."""
+    rho = contact_weights(W, rho_scale)
+    workspace = make_workspace(q.shape[0])
+    return newton_ac_core(
+        W, q, mu, rho, r, max_iter, tol, armijo, max_backtracks, prox_sigma, workspace
+    )
+
+
+@FC3D_METHODS.register(
+    "newton_ac", NewtonACOptions, "semismooth Newton on the Alart-Curnier function"
+)
+def solve_newton_ac(
+    problem: FrictionContact3D, r0: FloatArray | None, options: NewtonACOptions
+) -> tuple[FloatArray, SolverStatus, int]:
+    """Solve ``problem`` from ``r0`` (default r = 0); returns (r, status, Newton steps)."""
+    r = np.zeros(problem.q.shape[0]) if r0 is None else r0.copy()
+    code, steps, _ = newton_ac_kernel(
+        problem.W, problem.q, problem.mu, r, int(options.max_iter), float(options.tol),
+        float(options.armijo), int(options.max_backtracks), float(options.rho_scale),
+        float(options.prox_sigma),
+    )
+    return r, SolverStatus(code), steps
+
+
+__all__ = [
+    "NewtonACOptions",
+    "alart_curnier",
+    "alart_curnier_local",
+    "contact_weights",
+    "make_workspace",
+    "newton_ac_core",
+    "newton_ac_kernel",
+    "solve_newton_ac",
+]
