@@ -5,6 +5,8 @@ from mdi_envs.mechanics.models import (
     BlockableManipulatorParameters,
     BouncingBall,
     BouncingBallParameters,
+    DiffDriveParameters,
+    DiffDriveRobot,
     SlidingBlock,
     SlidingBlockParameters,
 )
@@ -15,6 +17,8 @@ __all__ = [
     "BlockableManipulatorParameters",
     "BouncingBall",
     "BouncingBallParameters",
+    "DiffDriveParameters",
+    "DiffDriveRobot",
     "ModelDefinition",
     "SlidingBlock",
     "SlidingBlockParameters",

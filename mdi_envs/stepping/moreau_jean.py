@@ -27,6 +27,13 @@ from mdi_envs.stepping._kernel import (
     make_step_kernels,
     make_workspace,
 )
+from mdi_envs.stepping._spatial_kernel import (
+    INFO_LIFTED_CONTACTS,
+    INFO_MODE,
+    SPATIAL_INFO_SIZE,
+    make_spatial_step_kernels,
+    make_spatial_workspace,
+)
 
 _KERNELS: dict[tuple[type[ModelDefinition], StepShortcuts], tuple[Any, Any]] = {}
 
@@ -41,6 +48,10 @@ class StepResult(NamedTuple):
         num_iter: pivots or candidate sets of that solve.
         num_active_contacts: contacts closed at the step's midpoint.
         lcp_size: complementarity variables solved for. num_equalities: ideal brake rows.
+        mode: the model's slip mode after the step (the robot's Table 1: 2, 3 or 5 DOF);
+            0 for models without modes.
+        num_lifted_contacts: load-transfer contacts whose load would be negative (P_N = 0, a
+            wheel that would lift off); 0 for models without load transfer.
     """
 
     q: FloatArray
@@ -51,6 +62,8 @@ class StepResult(NamedTuple):
     num_active_contacts: int
     lcp_size: int
     num_equalities: int
+    mode: int = 0
+    num_lifted_contacts: int = 0
 
 
 @dataclass
@@ -84,12 +97,19 @@ class MoreauJeanStepper:
             self.parameters = self.model.Parameters()  # type: ignore[attr-defined]
         self._values = self.parameters.values()
         key = (self.model, self.shortcuts)
+        spatial = self.model.CONTACT_DIMENSION == 3 and self.model.NUM_CONTACTS > 0
         if key not in _KERNELS:
-            _KERNELS[key] = make_step_kernels(
+            make_kernels = make_spatial_step_kernels if spatial else make_step_kernels
+            _KERNELS[key] = make_kernels(
                 self.model, compile_equations(self.model), self.shortcuts
             )
         self._step, self._step_batch = _KERNELS[key]
-        self._workspace = make_workspace(self.model)
+        if spatial:
+            self._workspace = make_spatial_workspace(self.model)
+            self._info_size = SPATIAL_INFO_SIZE
+        else:
+            self._workspace = make_workspace(self.model)
+            self._info_size = INFO_SIZE
         m = self.model
         self.num_dofs = m.NUM_DOFS
         self.num_inputs = m.NUM_INPUTS
@@ -114,13 +134,16 @@ class MoreauJeanStepper:
         tau_arr = self._vector(tau, "tau", self.num_inputs)
         brake = self._brake(brake_bound, (self.num_brakes,))
         q_out, u_out = np.empty(self.num_dofs), np.empty(self.num_dofs)
-        impulses, info = np.empty(self.num_impulses), np.empty(INFO_SIZE)
+        impulses, info = np.empty(self.num_impulses), np.empty(self._info_size)
         self._step(q_arr, u_arr, tau_arr, brake, float(self.time_step), self._values,
                    q_out, u_out, impulses, info, self._workspace)
+        mode, lifted = 0, 0
+        if self._info_size == SPATIAL_INFO_SIZE:
+            mode, lifted = int(info[INFO_MODE]), int(info[INFO_LIFTED_CONTACTS])
         return StepResult(
             q_out, u_out, impulses, SolverStatus(int(info[INFO_STATUS])),
             int(info[INFO_ITERATIONS]), int(info[INFO_ACTIVE_CONTACTS]),
-            int(info[INFO_LCP_SIZE]), int(info[INFO_EQUALITIES]),
+            int(info[INFO_LCP_SIZE]), int(info[INFO_EQUALITIES]), mode, lifted,
         )
 
     def step_batch(
@@ -140,7 +163,9 @@ class MoreauJeanStepper:
 
         Returns:
             (impulses (N, c*d + k), info (N, INFO_SIZE)) of each copy's last step; the status
-            column holds the worst status over the substeps.
+            column holds the worst status over the substeps. Spatial models report
+            ``SPATIAL_INFO_SIZE`` columns (the planar ones, then mode, lifted contacts and
+            solver residual; see ``mdi_envs.stepping._spatial_kernel``).
 
         Raises:
             ValueError: wrong shapes or dtypes, NaN/inf inputs, negative brake bounds.
@@ -165,7 +190,7 @@ class MoreauJeanStepper:
         if int(num_substeps) != num_substeps or num_substeps < 1:
             raise ValueError(f"num_substeps must be a positive integer, got {num_substeps!r}")
         impulses = np.empty((num_copies, self.num_impulses))
-        info = np.empty((num_copies, INFO_SIZE))
+        info = np.empty((num_copies, self._info_size))
         self._step_batch(q, u, tau_arr, brake, float(self.time_step), self._values,
                          int(num_substeps), impulses, info, self._workspace)
         return impulses, info

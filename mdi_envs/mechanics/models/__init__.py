@@ -5,6 +5,7 @@ from mdi_envs.mechanics.models.blockable_manipulator import (
     BlockableManipulatorParameters,
 )
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBall, BouncingBallParameters
+from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters, DiffDriveRobot
 from mdi_envs.mechanics.models.sliding_block import SlidingBlock, SlidingBlockParameters
 
 __all__ = [
@@ -12,6 +13,8 @@ __all__ = [
     "BlockableManipulatorParameters",
     "BouncingBall",
     "BouncingBallParameters",
+    "DiffDriveParameters",
+    "DiffDriveRobot",
     "SlidingBlock",
     "SlidingBlockParameters",
 ]

@@ -40,6 +40,7 @@ class ModelDefinition:
     CONTACT_DIMENSION: ClassVar[int] = 2  # 2: planar (normal, tangent); 3: spatial
     NUM_BRAKES: ClassVar[int] = 0
     HAS_CONSTANT_MASS: ClassVar[bool] = False
+    HAS_LOAD_TRANSFER: ClassVar[bool] = False  # normal impulses from ``normal_loads``, not gaps
     COORDINATE_NAMES: ClassVar[tuple[str, ...]]
 
     @staticmethod
@@ -76,6 +77,20 @@ class ModelDefinition:
     def friction_coefficients(p: NamedTuple) -> tuple[float, ...]:
         """C Coulomb friction coefficients mu_i >= 0."""
         return ()
+
+    @staticmethod
+    def normal_loads(p: NamedTuple) -> tuple[tuple[float, ...], tuple[tuple[float, ...], ...]]:
+        """Normal forces N = N0 + K F [N] as a linear function of the friction forces F.
+
+        Only for models with HAS_LOAD_TRANSFER (their contacts are always closed). Returns
+        (N0 (c,), K as c rows of c*(d-1) entries).
+        """
+        raise NotImplementedError
+
+    @staticmethod
+    def slip_mode(sliding: Any) -> int:
+        """The model's mode label from per-contact slide flags (c,); 0 for models without."""
+        return 0
 
     @staticmethod
     def brake_directions(q: Any, p: NamedTuple, ops: Any) -> tuple[tuple[Any, ...], ...]:

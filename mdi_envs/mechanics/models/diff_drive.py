@@ -113,6 +113,7 @@ class DiffDriveRobot(ModelDefinition):
     NUM_CONTACTS = 3
     CONTACT_DIMENSION = 3
     HAS_CONSTANT_MASS = True
+    HAS_LOAD_TRANSFER = True
     COORDINATE_NAMES = ("x", "y", "phi", "psi_L", "psi_R")
     Parameters = DiffDriveParameters
 
@@ -172,11 +173,32 @@ class DiffDriveRobot(ModelDefinition):
         shift_x = p.cm_height / span  # load moved to the axle per unit of sum F_x
         shift_y = p.cm_height / p.half_track  # load moved left -> right per unit of sum F_y
         axle0 = p.stick_offset * weight / span
-        row_left = (0.5 * shift_x, -0.5 * shift_y) * 3
-        row_right = (0.5 * shift_x, 0.5 * shift_y) * 3
-        row_stick = (-shift_x, 0.0) * 3
+        # explicit rows (numba compiles this too, and has no tuple repetition)
+        lx, ly = 0.5 * shift_x, 0.5 * shift_y
+        row_left = (lx, -ly, lx, -ly, lx, -ly)
+        row_right = (lx, ly, lx, ly, lx, ly)
+        row_stick = (-shift_x, 0.0, -shift_x, 0.0, -shift_x, 0.0)
         n0 = (0.5 * axle0, 0.5 * axle0, p.axle_offset * weight / span)
         return n0, (row_left, row_right, row_stick)
+
+    @staticmethod
+    def slip_mode(sliding: Any) -> int:
+        """The mode of Table 1 from the slip state of the contacts: 2, 3 or 5 (its DOF count).
+
+        Args:
+            sliding: per contact (left wheel, right wheel, stick) 1 if it slides, else 0.
+
+        Returns:
+            2 when both wheels roll (the robot moves like a unicycle: forward speed and yaw
+            rate), 3 when exactly one wheel slides, 5 when both slide. The stick slides
+            whenever the robot moves and does not enter the mode.
+        """
+        num_sliding = sliding[0] + sliding[1]
+        if num_sliding == 0:
+            return 2
+        if num_sliding == 1:
+            return 3
+        return 5
 
     @staticmethod
     def friction_coefficients(p: Any) -> tuple[float, ...]:

@@ -1,0 +1,382 @@
+"""The compiled Moreau-Jean midpoint step for spatial (3-D Coulomb) contacts, and its batch form.
+
+For models with ``CONTACT_DIMENSION == 3`` whose contacts are always closed and whose normal
+forces are not velocity constraints but follow from a load balance, ``N = N0 + K F`` as a linear
+function of the friction forces F (``model.normal_loads(p)``; the differential-drive robot,
+paper section 3.2, set I_NC). Per step of length dt (notation of DESIGN.md section 2):
+
+    q_M = q + dt/2 u
+    u_free = u + M^-1 (h(q_M, u) + B tau) dt
+    W_T: the 2 tangent rows per contact at q_M,  G_TT = W_T M^-1 W_T^T,  b_T = W_T u_free
+    u+ = u_free + M^-1 W_T^T P_T,                q+ = q_M + dt/2 u+.
+
+The impulses r_i = (P_N,i, P_T,i) solve one FC3D problem (De Saxce's formulation,
+``mdi_envs.solvers.fc3d``) whose tangent rows are the real slip velocities after the step,
+
+    u_T = G_TT P_T + b_T                      (no tangential restitution),
+
+and whose normal rows encode the load transfer,
+
+    u_N,i = s (P_N,i - N0_i dt - K_i . P_T),   s > 0 (the mean of diag G_TT),
+
+so that Signorini's condition 0 <= u_N _|_ P_N >= 0 gives P_N = N0 dt + K P_T while that load
+is positive, and P_N = 0 (a lifted contact, counted in ``INFO_LIFTED_CONTACTS``) otherwise;
+the cone conditions give isotropic Coulomb friction with normal impulses that depend on the
+friction impulses. The complementarity is invariant under the positive scale s, which only
+makes both kinds of rows commensurate. The problem is solved in units of the weight impulse
+P0 = sum(N0) dt and the velocity s P0 (r / P0, u / (s P0)), to an absolute tolerance
+``NEWTON_TOL`` in these units, by the compiled semismooth Newton method on the Alart-Curnier
+function (``newton_ac_core``), warm-started from the previous step's impulses. If that does not
+converge it restarts from the static loads without friction, then from zero, and otherwise
+keeps the iterate with the smallest residual (``INFO_ITERATIONS`` counts all Newton steps).
+Where the load transfer is strong enough to lift contacts (a tall, narrow robot that would tip
+over) the problem can have several solutions and Newton may still fail: the status says so.
+
+The wheels' lateral rows are identical (both lie on the axle), so G_TT is singular while both
+wheels roll: the split of the lateral impulse between them is not determined by the rigid model
+(any split inside the cones is a solution; the motion and the normal impulses, which depend on
+its sum only, are). The Newton method's proximal safeguard handles this.
+
+Mode (the paper's Table 1) from the slip after the step: contact i slides when
+``|W_T,i u+| > SLIP_RTOL * v_ref + SLIP_ATOL * s P0``, with v_ref the largest single term
+``|W_T[r, j] u+_j|`` of any slip velocity (the robot's speed scale); ``model.slip_mode`` maps the
+per-contact flags to the mode (2, 3 or 5 for the robot), reported in ``INFO_MODE``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from mdi_envs.mechanics.compiled import CompiledEquations
+from mdi_envs.mechanics.models.base import ModelDefinition
+from mdi_envs.solvers._linalg import invert_into
+from mdi_envs.solvers.fc3d.newton_ac import make_workspace as make_newton_workspace
+from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
+from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED
+from mdi_envs.stepping._kernel import (
+    INFO_ACTIVE_CONTACTS,
+    INFO_EQUALITIES,
+    INFO_ITERATIONS,
+    INFO_LCP_SIZE,
+    INFO_SIZE,
+    INFO_STATUS,
+    StepShortcuts,
+)
+
+# The spatial step's diagnostics extend the planar layout (same meaning of entries 0..4;
+# INFO_LCP_SIZE holds the FC3D problem size 3 c).
+INFO_MODE = INFO_SIZE  # the model's slip mode (Table 1: 2, 3, 5 DOF); 0 without modes
+INFO_LIFTED_CONTACTS = INFO_SIZE + 1  # contacts whose load would be negative: P_N = 0
+INFO_RESIDUAL = INFO_SIZE + 2  # the FC3D solver's shared (relative) residual
+SPATIAL_INFO_SIZE = INFO_SIZE + 3
+
+NEWTON_TOL = 1e-12
+"""Absolute residual tolerance of the scaled FC3D problem (in units of the weight impulse)."""
+NEWTON_TOL_FLOOR = 1e-14
+"""Smallest relative tolerance asked of the solver (its residual is relative to |q|)."""
+NEWTON_MAX_ITER = 100
+SLIP_RTOL = 1e-7
+"""A contact slides when its slip exceeds this fraction of the speed scale v_ref ..."""
+SLIP_ATOL = 1e-8
+"""... plus this fraction of the solver's velocity unit s P0 (its accuracy is ~1e-12 of it)."""
+
+
+def make_spatial_workspace(model: type[ModelDefinition]) -> tuple[Any, ...]:
+    """Preallocated arrays for the spatial ``step`` of ``model``, reused across steps and copies.
+
+    The last entries are the warm start (previous impulses, (c*3,)) and its validity flag.
+    """
+    n, m, c = model.NUM_DOFS, model.NUM_INPUTS, model.NUM_CONTACTS
+    f = np.empty
+    return (
+        f(n), f((n, n)), f((n, n)), f(n), f((n, m)), f(n), f((3 * c, n)), f(c),
+        f((2 * c, n)), f((n, 2 * c)), f((2 * c, 2 * c)), f(2 * c), f(c), f((c, 2 * c)),
+        f((3 * c, 3 * c)), f(3 * c), f(3 * c), f(c), f((n, n)), f(n), np.zeros(c, np.int64),
+        make_newton_workspace(3 * c), np.zeros(1, np.int64), f(3 * c), np.zeros(3 * c),
+        np.zeros(1, np.int64),
+    )
+
+
+def make_spatial_step_kernels(
+    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts
+) -> tuple[Any, Any]:
+    """Compile ``step(...)`` and ``step_batch(...)`` for a spatial ``model``.
+
+    The kernels have the planar kernels' signatures (``mdi_envs.stepping._kernel``) and write
+    ``SPATIAL_INFO_SIZE`` diagnostics.
+
+    Raises:
+        NotImplementedError: the model is not spatial, has brakes, or lacks ``normal_loads``.
+    """
+    n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
+    c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
+    if d != 3 or c == 0:
+        raise NotImplementedError(f"{model.__name__}: the spatial step needs 3-D contacts")
+    if k > 0:
+        raise NotImplementedError(f"{model.__name__}: brakes are not supported with 3-D contacts")
+    if not model.HAS_LOAD_TRANSFER:
+        raise NotImplementedError(
+            f"{model.__name__}: the spatial step needs normal loads N = N0 + K F "
+            "(unilateral 3-D contacts with normal rows are not implemented)"
+        )
+    mass, forces, inputs = eq.mass, eq.forces, eq.inputs
+    contact_rows, friction_coefficients = eq.contact_rows, eq.friction_coefficients
+    normal_loads = njit(model.normal_loads)
+    slip_mode = njit(model.slip_mode)
+    reuse_mass = shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
+    c2 = 2 * c
+    c3 = 3 * c
+
+    @njit
+    def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
+        """Advance one step of length dt [s].
+
+        Args:
+            q, u: (n,) coordinates and velocities at t_k. tau: (m,) inputs, held over the step.
+            brake_bound: (0,) unused (no brakes). dt: step [s]. p: parameter record.
+            q_out, u_out: (n,) outputs at t_k + dt (overwritten).
+            impulses: (c*3,) output: per contact (P_N, P_T1, P_T2) [N s].
+            info: (SPATIAL_INFO_SIZE,) output diagnostics (INFO_* constants).
+            ws: workspace from ``make_spatial_workspace``; carries the warm start.
+        """
+        (qm, M, Minv, h, B, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho, Mwork,
+         col, sliding, nws, mass_ready, r_best, warm, warm_ready) = ws
+        for i in range(n):
+            qm[i] = q[i] + 0.5 * dt * u[i]
+        forces(qm, u, p, h)
+        inputs(qm, p, B)
+        ok = True
+        if not (reuse_mass and mass_ready[0] == 1):
+            mass(qm, p, M)
+            ok = invert_into(M, Minv, Mwork, col)
+            mass_ready[0] = 1 if ok else 0
+        for i in range(n):
+            f = h[i]
+            for j in range(num_inputs):
+                f += B[i, j] * tau[j]
+            col[i] = f * dt
+        for i in range(n):
+            acc = u[i]
+            for j in range(n):
+                acc += Minv[i, j] * col[j]
+            ufree[i] = acc
+        for i in range(c3):
+            impulses[i] = 0.0
+        info[INFO_STATUS] = CODE_CONVERGED
+        info[INFO_ITERATIONS] = 0.0
+        info[INFO_ACTIVE_CONTACTS] = c
+        info[INFO_LCP_SIZE] = c3
+        info[INFO_EQUALITIES] = 0.0
+        info[INFO_MODE] = 0.0
+        info[INFO_LIFTED_CONTACTS] = 0.0
+        info[INFO_RESIDUAL] = 0.0
+        if not ok:
+            info[INFO_STATUS] = CODE_BREAKDOWN
+            info[INFO_ACTIVE_CONTACTS] = 0.0
+            info[INFO_LCP_SIZE] = 0.0
+            for i in range(n):
+                u_out[i] = ufree[i]
+                q_out[i] = qm[i] + 0.5 * dt * ufree[i]
+            return
+
+        # Tangent rows at the midpoint, G_TT = W_T M^-1 W_T^T and b_T = W_T u_free.
+        contact_rows(qm, p, Wc)
+        friction_coefficients(p, mu)
+        for i in range(c):
+            for a in range(2):
+                for j in range(n):
+                    WT[2 * i + a, j] = Wc[3 * i + 1 + a, j]
+        for j in range(n):
+            for s in range(c2):
+                acc = 0.0
+                for t in range(n):
+                    acc += Minv[j, t] * WT[s, t]
+                MinvWt[j, s] = acc
+        trace = 0.0
+        for r_ in range(c2):
+            acc = 0.0
+            for j in range(n):
+                acc += WT[r_, j] * ufree[j]
+            bT[r_] = acc
+            for s in range(c2):
+                acc = 0.0
+                for j in range(n):
+                    acc += WT[r_, j] * MinvWt[j, s]
+                G[r_, s] = acc
+            trace += G[r_, r_]
+        scale = trace / c2
+        if not scale > 0.0:
+            scale = 1.0
+
+        # Loads N = N0 + K F, and the weight impulse P0 as the impulse unit.
+        loads0, loads_k = normal_loads(p)
+        weight = 0.0
+        for i in range(c):
+            n0[i] = loads0[i]
+            weight += loads0[i]
+            row = loads_k[i]
+            for s in range(c2):
+                K[i, s] = row[s]
+        p0 = weight * dt
+        if not p0 > 0.0:
+            p0 = dt
+        v0 = scale * p0
+
+        # The scaled FC3D problem u' = Wf r' + qf, r' = r / p0, u' = u / (s p0).
+        for i in range(c):
+            ni = 3 * i
+            for j in range(c):
+                nj = 3 * j
+                Wf[ni, nj] = 1.0 if i == j else 0.0
+                for a in range(2):
+                    Wf[ni, nj + 1 + a] = -K[i, 2 * j + a]
+                    Wf[ni + 1 + a, nj] = 0.0
+                    for b in range(2):
+                        Wf[ni + 1 + a, nj + 1 + b] = G[2 * i + a, 2 * j + b] / scale
+            qf[ni] = -n0[i] * dt / p0
+            qf[ni + 1] = bT[2 * i] / v0
+            qf[ni + 2] = bT[2 * i + 1] / v0
+        for i in range(c):
+            ni = 3 * i
+            acc = 0.0
+            for a in range(3):
+                for b in range(3):
+                    acc += Wf[ni + a, ni + b] * Wf[ni + a, ni + b]
+            rho[i] = 1.0 / np.sqrt(acc)
+        # The solver's residual is relative to max(|qf|, 1): ask for NEWTON_TOL absolute, that
+        # is in units of the weight impulse, whatever the speed (floored above round-off).
+        q_norm = 0.0
+        for i in range(c3):
+            q_norm += qf[i] * qf[i]
+        tol = max(NEWTON_TOL / max(np.sqrt(q_norm), 1.0), NEWTON_TOL_FLOOR)
+        # Starts, until one converges: the previous impulses (warm), the static loads without
+        # friction, zero. Keep the best result (by residual) if none does.
+        attempt = 0 if warm_ready[0] == 1 else 1
+        code = CODE_BREAKDOWN
+        iterations = 0
+        residual = np.inf
+        best = np.inf
+        while attempt <= 2:
+            if attempt == 0:
+                for i in range(c3):
+                    r[i] = warm[i] / p0
+            else:
+                _static_start(n0, dt / p0 if attempt == 1 else 0.0, r)
+            code, steps, residual = newton_ac_core(
+                Wf, qf, mu, rho, r, NEWTON_MAX_ITER, tol, 1e-4, 40, 1.0, nws
+            )
+            iterations += steps
+            if code == CODE_CONVERGED:
+                break
+            if residual < best:
+                best = residual
+                for i in range(c3):
+                    r_best[i] = r[i]
+            attempt += 1
+        if code != CODE_CONVERGED and best < np.inf:
+            residual = best
+            for i in range(c3):
+                r[i] = r_best[i]
+        info[INFO_STATUS] = code
+        info[INFO_ITERATIONS] = iterations
+        info[INFO_RESIDUAL] = residual
+        finite = True
+        for i in range(c3):
+            if not np.isfinite(r[i]):
+                finite = False
+        if finite:
+            for i in range(c3):
+                impulses[i] = p0 * r[i]
+                warm[i] = impulses[i]
+            warm_ready[0] = 1
+        else:  # keep the state finite; the status says the solve failed
+            info[INFO_STATUS] = CODE_BREAKDOWN
+            warm_ready[0] = 0
+
+        # u+ = u_free + M^-1 W_T^T P_T, q+ = q_M + dt/2 u+.
+        for j in range(n):
+            acc = ufree[j]
+            for i in range(c):
+                acc += MinvWt[j, 2 * i] * impulses[3 * i + 1]
+                acc += MinvWt[j, 2 * i + 1] * impulses[3 * i + 2]
+            u_out[j] = acc
+            q_out[j] = qm[j] + 0.5 * dt * acc
+
+        # Slip after the step, mode and lifted contacts.
+        v_ref = 0.0
+        for r_ in range(c2):
+            for j in range(n):
+                term = abs(WT[r_, j] * u_out[j])
+                if term > v_ref:
+                    v_ref = term
+        slip_tol = SLIP_RTOL * v_ref + SLIP_ATOL * v0
+        lifted = 0
+        for i in range(c):
+            s1 = 0.0
+            s2 = 0.0
+            for j in range(n):
+                s1 += WT[2 * i, j] * u_out[j]
+                s2 += WT[2 * i + 1, j] * u_out[j]
+            sliding[i] = 1 if np.sqrt(s1 * s1 + s2 * s2) > slip_tol else 0
+            if impulses[3 * i] <= 1e-10 * p0:
+                lifted += 1
+        info[INFO_LIFTED_CONTACTS] = lifted
+        info[INFO_MODE] = slip_mode(sliding)
+
+    @njit
+    def step_batch(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, ws):  # noqa: ANN001
+        """Advance N independent copies by ``num_substeps`` steps each, in place.
+
+        Args:
+            Q, U: (N, n) states, overwritten. TAU: (N, m) inputs. BRAKE: (N, 0) unused.
+            dt: step [s]. p: parameter record. num_substeps: steps per call.
+            IMPULSES: (N, c*3) output: the impulses of each copy's last step.
+            INFO: (N, SPATIAL_INFO_SIZE) output: diagnostics of each copy's last step, except
+                the status, which is the worst (largest code) over the substeps.
+            ws: one workspace from ``make_spatial_workspace``, shared by the copies; each copy
+                starts cold and warm-starts its later substeps from its previous one.
+        """
+        num_copies = Q.shape[0]
+        q_next = np.empty(n)
+        u_next = np.empty(n)
+        warm_ready = ws[-1]
+        for e in range(num_copies):
+            worst = 0.0
+            warm_ready[0] = 0
+            for _ in range(num_substeps):
+                step(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e], INFO[e], ws)
+                for j in range(n):
+                    Q[e, j] = q_next[j]
+                    U[e, j] = u_next[j]
+                if INFO[e, INFO_STATUS] > worst:
+                    worst = INFO[e, INFO_STATUS]
+            INFO[e, INFO_STATUS] = worst
+
+    return step, step_batch
+
+
+@njit(cache=True)
+def _static_start(n0, scale, r):  # noqa: ANN001
+    """Set r to the static loads N0 * scale (clipped at 0) with no friction (scale 0: r = 0)."""
+    for i in range(n0.shape[0]):
+        r[3 * i] = max(n0[i] * scale, 0.0)
+        r[3 * i + 1] = 0.0
+        r[3 * i + 2] = 0.0
+
+
+__all__ = [
+    "INFO_LIFTED_CONTACTS",
+    "INFO_MODE",
+    "INFO_RESIDUAL",
+    "NEWTON_MAX_ITER",
+    "NEWTON_TOL",
+    "NEWTON_TOL_FLOOR",
+    "SLIP_ATOL",
+    "SLIP_RTOL",
+    "SPATIAL_INFO_SIZE",
+    "make_spatial_step_kernels",
+    "make_spatial_workspace",
+]
