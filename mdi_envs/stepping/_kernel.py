@@ -30,6 +30,15 @@ from mdi_envs.solvers.lcp.enumerative import enumerative_kernel
 from mdi_envs.solvers.lcp.lemke import lemke_kernel
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED
 
+GAP_TOLERANCE = 1e-12
+"""[m] A contact counts as closed at the midpoint when g_i(q_M) <= this: a body resting on a
+surface keeps gaps of rounding size (~1e-21 m), which must not open the contact for a step."""
+
+IDEAL_BRAKE_IMPULSE = 1e6
+"""[N s or N m s] A brake whose impulse bound a dt reaches this acts as the ideal brake
+(equality row). The Tresca rows carry P_B = P_R - a dt, which loses all precision when a dt is
+many orders above P_B; no brake of these models needs impulses anywhere near this bound."""
+
 # Layout of the per-step diagnostics vector.
 INFO_STATUS = 0  # SolverStatus code of the step's solve (CONVERGED when nothing to solve)
 INFO_ITERATIONS = 1  # pivots / candidates of the LCP solve
@@ -59,23 +68,67 @@ class StepShortcuts(NamedTuple):
     direct_solve_max_size: int = 3
 
 
-def make_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, ...]:
-    """Preallocated arrays for ``step`` of ``model``, reused across steps and batch copies."""
+Layout = dict[str, tuple[int, tuple[int, ...]]]
+
+
+def _workspace_layout(model: type[ModelDefinition]) -> tuple[Layout, int, Layout, int]:
+    """Offsets and shapes of the step's scratch arrays inside one float and one int buffer."""
     n, m = model.NUM_DOFS, model.NUM_INPUTS
     c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
     rows = c * d + k
-    size = 3 * c + 2 * k + k  # LCP variables (3 per contact, 2 per Tresca brake) + equalities
-    lcp = 3 * c + 2 * k
-    f = np.empty
-    return (
-        f(n), f((n, n)), f((n, n)), f(n), f((n, m)), f(n), f(c), f((c * d, n)), f((k, n)),
-        f(c), f(c), f((rows, n)), f((n, rows)), f((rows, rows)), f(rows), f(rows),
-        f((rows, size)), f(rows), f((size, size)), f(size), f((lcp, lcp)), f(lcp), f(lcp),
-        f((lcp, lcp + 2)), np.empty(lcp, np.int64), np.empty(2 * lcp + 1, np.int64),
-        np.empty(2 * lcp + 1, np.int64), np.empty(lcp + 1, np.int64), f(lcp + 2),
-        f((k, k)), f((k, k)), f((k, k)), f(k), f(size), f(rows), f((n, n)), f(n),
-        np.empty(rows, np.int64), np.zeros(1, np.int64),
-    )
+    lcp = 3 * c + 2 * k  # LCP variables: 3 per contact, 2 per Tresca brake
+    size = lcp + k  # plus the ideal-brake equalities
+    float_shapes = {
+        "qm": (n,), "M": (n, n), "Minv": (n, n), "h": (n,), "B": (n, m), "ufree": (n,),
+        "g": (c,), "Wc": (c * d, n), "Wb": (k, n), "eps": (c,), "mu": (c,), "Wr": (rows, n),
+        "MinvWt": (n, rows), "G": (rows, rows), "gfree": (rows,), "gpre": (rows,),
+        "S": (rows, size), "s0": (rows,), "A": (size, size), "a": (size,),
+        "Mred": (lcp, lcp), "qred": (lcp,), "z": (lcp,), "T": (lcp, lcp + 2),
+        "pivot_row": (lcp + 2,), "Aee": (k, k), "Aee_inv": (k, k), "lu_work": (k, k),
+        "lu_col": (k,), "v": (size,), "P": (rows,), "Mwork": (n, n), "col": (n,),
+    }
+    int_shapes = {
+        "basis": (lcp,), "row_of": (2 * lcp + 1,), "slot_of": (2 * lcp + 1,),
+        "slot_var": (lcp + 1,), "row_ref": (rows,), "mass_ready": (1,),
+    }
+
+    def offsets(shapes: dict[str, tuple[int, ...]]) -> tuple[Layout, int]:
+        layout: Layout = {}
+        total = 0
+        for name, shape in shapes.items():
+            layout[name] = (total, shape)
+            total += int(np.prod(shape))
+        return layout, total
+
+    float_layout, float_total = offsets(float_shapes)
+    int_layout, int_total = offsets(int_shapes)
+    return float_layout, float_total, int_layout, int_total
+
+
+def make_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, np.ndarray]:
+    """Scratch buffers of ``step`` for ``model`` (one float64, one int64), reused across steps.
+
+    Two flat buffers keep the compiled call cheap to dispatch from Python (numba types every
+    element of a tuple argument on each call); the step carves its arrays out of them once per
+    call, also for a whole batch.
+    """
+    _, float_total, _, int_total = _workspace_layout(model)
+    return np.empty(max(float_total, 1)), np.zeros(max(int_total, 1), np.int64)
+
+
+def _make_carver(layout: Layout) -> Any:
+    """A compiled function returning the views of ``layout`` into a flat buffer, in order.
+
+    Its source is generated so that every offset and shape is a compile-time constant.
+    """
+    lines = ["def carve(buffer):"]
+    for name, (offset, shape) in layout.items():
+        size = int(np.prod(shape))
+        lines.append(f"    {name} = buffer[{offset}:{offset + size}].reshape({shape!r})")
+    lines.append(f"    return ({', '.join(layout)},)")
+    namespace: dict[str, Any] = {}
+    exec("\n".join(lines), namespace)  # noqa: S102 - generated from the layout's constants
+    return njit(namespace["carve"])
 
 
 def make_step_kernels(
@@ -94,24 +147,29 @@ def make_step_kernels(
     keep_frictionless_rows = not shortcuts.skip_frictionless_rows
     reuse_mass = shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
     direct_solve_max_size = shortcuts.direct_solve_max_size
+    float_layout, _, int_layout, _ = _workspace_layout(model)
+    carve_floats = _make_carver(float_layout)
+    carve_ints = _make_carver(int_layout)
 
     @njit
-    def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
+    def advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fs, js):  # noqa: ANN001
         """Advance one step of length dt [s].
 
         Args:
             q, u: (n,) coordinates and velocities at t_k. tau: (m,) inputs, held over the step.
-            brake_bound: (k,) brake bounds a >= 0 [force or torque]: 0 released, inf ideal.
+            brake_bound: (k,) brake bounds a >= 0 [force or torque]: 0 released, inf (or any
+                a with a dt >= IDEAL_BRAKE_IMPULSE) ideal.
             dt: step [s]. p: the model's parameter record.
             q_out, u_out: (n,) outputs at t_k + dt (overwritten).
             impulses: (c*d + k,) output, overwritten: per contact P_N then P_T, then the
                 brake impulses [N s or N m s]; zero for open contacts and released brakes.
             info: (INFO_SIZE,) output diagnostics (see the INFO_* constants).
-            ws: workspace from ``make_workspace``.
+            fs, js: the float and int scratch views carved from ``make_workspace``'s buffers.
         """
         (qm, M, Minv, h, B, ufree, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree, gpre, S, s0,
-         A, a, Mred, qred, z, T, basis, row_of, slot_of, slot_var, pivot_row, Aee, Aee_inv,
-         lu_work, lu_col, v, P, Mwork, col, row_ref, mass_ready) = ws
+         A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P, Mwork,
+         col) = fs
+        basis, row_of, slot_of, slot_var, row_ref, mass_ready = js
         for i in range(n):
             qm[i] = q[i] + 0.5 * dt * u[i]
         forces(qm, u, p, h)
@@ -150,14 +208,14 @@ def make_step_kernels(
         num_eq = 0
         num_active = 0
         for i in range(c):
-            if g[i] <= 0.0:
+            if g[i] <= GAP_TOLERANCE:
                 num_active += 1
                 num_rows += 2 if mu[i] > 0.0 or keep_frictionless_rows else 1
                 num_x += 3 if mu[i] > 0.0 or keep_frictionless_rows else 1
         for j in range(k):
             if brake_bound[j] > 0.0:
                 num_rows += 1
-                if np.isinf(brake_bound[j]):
+                if brake_bound[j] * dt >= IDEAL_BRAKE_IMPULSE:
                     num_eq += 1
                 else:
                     num_x += 2
@@ -171,7 +229,7 @@ def make_step_kernels(
         # Rows W (num_rows, n), their free and pre-step velocities, and eps on normal rows.
         r = 0
         for i in range(c):
-            if g[i] <= 0.0:
+            if g[i] <= GAP_TOLERANCE:
                 for t in range(2 if mu[i] > 0.0 or keep_frictionless_rows else 1):
                     for j in range(n):
                         Wr[r, j] = Wc[i * d + t, j]
@@ -217,7 +275,7 @@ def make_step_kernels(
         x = 0
         y = num_x
         for i in range(c):
-            if g[i] > 0.0:
+            if g[i] > GAP_TOLERANCE:
                 continue
             S[r, x] = 1.0
             if mu[i] > 0.0 or keep_frictionless_rows:
@@ -234,7 +292,7 @@ def make_step_kernels(
             bound = brake_bound[b]
             if bound <= 0.0:
                 continue
-            if np.isinf(bound):
+            if bound * dt >= IDEAL_BRAKE_IMPULSE:
                 S[r, y] = 1.0
                 y += 1
             else:
@@ -247,7 +305,7 @@ def make_step_kernels(
         x = 0
         y = num_x
         for i in range(c):
-            if g[i] > 0.0:
+            if g[i] > GAP_TOLERANCE:
                 continue
             _set_row(A, a, x, G, S, s0, gfree, gpre, r, eps[i], num_rows, size)
             if mu[i] > 0.0 or keep_frictionless_rows:
@@ -262,7 +320,7 @@ def make_step_kernels(
             bound = brake_bound[b]
             if bound <= 0.0:
                 continue
-            if np.isinf(bound):
+            if bound * dt >= IDEAL_BRAKE_IMPULSE:
                 _set_row(A, a, y, G, S, s0, gfree, gpre, r, 0.0, num_rows, size)
                 y += 1
             else:
@@ -295,6 +353,12 @@ def make_step_kernels(
             q_out[j] = qm[j] + 0.5 * dt * acc
 
     @njit
+    def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
+        """One step (arguments as ``advance``; ws = ``make_workspace(model)``)."""
+        advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info,
+                carve_floats(ws[0]), carve_ints(ws[1]))
+
+    @njit
     def step_batch(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, ws):  # noqa: ANN001
         """Advance N independent copies by ``num_substeps`` steps each, in place.
 
@@ -307,12 +371,15 @@ def make_step_kernels(
             ws: one workspace from ``make_workspace``, shared by the copies.
         """
         num_copies = Q.shape[0]
+        fs = carve_floats(ws[0])
+        js = carve_ints(ws[1])
         q_next = np.empty(n)
         u_next = np.empty(n)
         for e in range(num_copies):
             worst = 0.0
             for _ in range(num_substeps):
-                step(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e], INFO[e], ws)
+                advance(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e],
+                        INFO[e], fs, js)
                 for j in range(n):
                     Q[e, j] = q_next[j]
                     U[e, j] = u_next[j]
@@ -402,6 +469,8 @@ __all__ = [
     "INFO_ITERATIONS",
     "INFO_LCP_SIZE",
     "INFO_SIZE",
+    "GAP_TOLERANCE",
+    "IDEAL_BRAKE_IMPULSE",
     "INFO_STATUS",
     "StepShortcuts",
     "make_step_kernels",

@@ -7,6 +7,7 @@ state, inputs and brake commands, in one compiled call (for vector environments)
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -90,11 +91,17 @@ class MoreauJeanStepper:
     shortcuts: StepShortcuts = StepShortcuts()
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.time_step, (int, float)) and np.isfinite(self.time_step)
+        if not (isinstance(self.time_step, numbers.Real) and np.isfinite(self.time_step)
                 and self.time_step > 0):
             raise ValueError(f"time_step must be a finite number > 0, got {self.time_step!r}")
+        parameters_type = self.model.Parameters  # type: ignore[attr-defined]
         if self.parameters is None:
-            self.parameters = self.model.Parameters()  # type: ignore[attr-defined]
+            self.parameters = parameters_type()
+        if not isinstance(self.parameters, parameters_type):
+            raise ValueError(
+                f"parameters must be a {parameters_type.__name__} for {self.model.__name__}, "
+                f"got {type(self.parameters).__name__}"
+            )
         self._values = self.parameters.values()
         key = (self.model, self.shortcuts)
         spatial = self.model.CONTACT_DIMENSION == 3 and self.model.NUM_CONTACTS > 0
@@ -177,6 +184,8 @@ class MoreauJeanStepper:
                 raise ValueError(
                     f"{name} must be a C-contiguous float64 array of shape (N, {self.num_dofs})"
                 )
+            if not np.isfinite(array).all():
+                raise ValueError(f"{name} contains NaN or inf entries")
         num_copies = q.shape[0]
         if u.shape[0] != num_copies:
             raise ValueError(f"u has {u.shape[0]} rows, q has {num_copies}")
