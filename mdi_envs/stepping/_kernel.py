@@ -78,7 +78,7 @@ def _workspace_layout(model: type[ModelDefinition]) -> tuple[Layout, int, Layout
     rows = c * d + k
     lcp = 3 * c + 2 * k  # LCP variables: 3 per contact, 2 per Tresca brake
     size = lcp + k  # plus the ideal-brake equalities
-    float_shapes = {
+    float_shapes: dict[str, tuple[int, ...]] = {
         "qm": (n,), "M": (n, n), "Minv": (n, n), "h": (n,), "B": (n, m), "ufree": (n,),
         "g": (c,), "Wc": (c * d, n), "Wb": (k, n), "eps": (c,), "mu": (c,), "Wr": (rows, n),
         "MinvWt": (n, rows), "G": (rows, rows), "gfree": (rows,), "gpre": (rows,),
@@ -87,7 +87,7 @@ def _workspace_layout(model: type[ModelDefinition]) -> tuple[Layout, int, Layout
         "pivot_row": (lcp + 2,), "Aee": (k, k), "Aee_inv": (k, k), "lu_work": (k, k),
         "lu_col": (k,), "v": (size,), "P": (rows,), "Mwork": (n, n), "col": (n,),
     }
-    int_shapes = {
+    int_shapes: dict[str, tuple[int, ...]] = {
         "basis": (lcp,), "row_of": (2 * lcp + 1,), "slot_of": (2 * lcp + 1,),
         "slot_var": (lcp + 1,), "row_ref": (rows,), "mass_ready": (1,),
     }

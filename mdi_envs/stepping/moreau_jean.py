@@ -8,7 +8,7 @@ state, inputs and brake commands, in one compiled call (for vector environments)
 from __future__ import annotations
 
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -89,6 +89,15 @@ class MoreauJeanStepper:
     parameters: Any = None
     time_step: float = 1e-3
     shortcuts: StepShortcuts = StepShortcuts()
+    num_dofs: int = field(init=False)
+    num_inputs: int = field(init=False)
+    num_brakes: int = field(init=False)
+    num_impulses: int = field(init=False)
+    _values: Any = field(init=False, repr=False)
+    _workspace: Any = field(init=False, repr=False)
+    _step: Any = field(init=False, repr=False)
+    _step_batch: Any = field(init=False, repr=False)
+    _info_size: int = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if not (isinstance(self.time_step, numbers.Real) and np.isfinite(self.time_step)
