@@ -73,4 +73,49 @@ def plot_time_vs_size(
     return out
 
 
-__all__ = ["plot_complementarity", "plot_time_vs_size"]
+def plot_manipulator_rollout(
+    t: FloatArray,
+    q: FloatArray,
+    u: FloatArray,
+    brake_impulse: FloatArray,
+    reference: tuple[FloatArray, FloatArray, FloatArray],
+    title: str,
+    path: str | Path,
+) -> Path:
+    """Paper-style figure (Yunt & Glocker, Figs. 3-4) of a manipulator rollout.
+
+    Args:
+        t: (T,) times [s]. q: (T, 2) angles alpha, beta [rad]. u: (T, 2) rates [rad/s].
+        brake_impulse: (T,) brake impulse per step [N m s].
+        reference: (t_ref, q_ref, u_ref) of a reference solution, drawn dashed.
+        title: figure title. path: PNG file.
+
+    Returns:
+        The path of the written PNG.
+    """
+    plt = _pyplot()
+    t_ref, q_ref, u_ref = reference
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    for j, name in enumerate(("alpha", "beta")):
+        axes[0].plot(t, q[:, j], label=f"{name} (time-stepping)")
+        axes[0].plot(t_ref, q_ref[:, j], "k--", linewidth=0.8)
+        axes[1].plot(t, u[:, j], label=f"{name}' (time-stepping)")
+        axes[1].plot(t_ref, u_ref[:, j], "k--", linewidth=0.8)
+    axes[0].set_ylabel("angle [rad]")
+    axes[1].set_ylabel("rate [rad/s]")
+    axes[2].plot(t, brake_impulse, color="tab:red")
+    axes[2].set_ylabel("brake impulse [N m s]")
+    axes[2].set_xlabel("time [s]")
+    axes[0].legend(fontsize=8, title="dashed: event-driven reference", title_fontsize=8)
+    axes[1].legend(fontsize=8)
+    axes[0].set_title(title)
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    out = Path(path)
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+    return out
+
+
+__all__ = ["plot_complementarity", "plot_manipulator_rollout", "plot_time_vs_size"]

@@ -26,7 +26,9 @@ def test_demo_writes_its_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert main(["demo", "--output", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "CONVERGED" in out
-    for name in ("lcp_methods_time.png", "lcp_complementarity.png"):
+    assert "max deviation from the event-driven reference" in out
+    for name in ("lcp_methods_time.png", "lcp_complementarity.png",
+                 "manipulator_brake_schedule.png"):
         assert (tmp_path / name).stat().st_size > 1000
 
 
