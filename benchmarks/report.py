@@ -90,7 +90,7 @@ def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, An
     return rows
 
 
-def _markdown(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
+def markdown_table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
     """A GitHub Markdown table."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(row) + " |" for row in rows]
@@ -125,7 +125,7 @@ def size_tables(aggregates: Sequence[dict[str, Any]], entries: Sequence[str]) ->
             f"median over {instances} instances of the median time per solve in µs · median "
             "iterations · largest residual)"
         )
-        blocks.append(title + "\n\n" + _markdown(header, rows))
+        blocks.append(title + "\n\n" + markdown_table(header, rows))
     return "\n\n".join(blocks)
 
 
@@ -164,7 +164,7 @@ def peer_table(rows: Sequence[dict[str, Any]]) -> str:
         ]
         for row in rows
     ]
-    return _markdown(header, body)
+    return markdown_table(header, body)
 
 
 def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -210,7 +210,7 @@ def ratio_table(summary: Sequence[dict[str, Any]]) -> str:
         ]
         for s in summary
     ]
-    return _markdown(header, body)
+    return markdown_table(header, body)
 
 
 def _family_axes(
@@ -349,6 +349,7 @@ __all__ = [
     "format_residual",
     "format_ratio",
     "format_us",
+    "markdown_table",
     "peer_table",
     "plot_ratios",
     "plot_residual_vs_size",

@@ -13,9 +13,6 @@ Markdown results tables (the ones in ``benchmarks/README.md``) on stdout.
 from __future__ import annotations
 
 import argparse
-import os
-import sys
-import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -30,7 +27,14 @@ from benchmarks.problems import (
     peer_lcp_problems,
     random_problem,
 )
-from benchmarks.timing import TimingPlan, machine_info, probe_first_calls, time_interleaved
+from benchmarks.timing import (
+    Progress,
+    TimingPlan,
+    load_average,
+    machine_info,
+    probe_first_calls,
+    time_interleaved,
+)
 
 SIZE_STUDY_COLUMNS = (*E.LCP_METHODS, E.QUANTECON.name)
 
@@ -72,22 +76,6 @@ QUICK = BenchConfig(
     peer_plan=TimingPlan(budget_s=0.02, min_rounds=3, max_rounds=30),
     cold_compile=False,
 )
-
-
-class Progress:
-    """Progress lines on stderr, stamped with the seconds since the start of the run."""
-
-    def __init__(self) -> None:
-        self.start = time.perf_counter()
-
-    @property
-    def elapsed(self) -> float:
-        """Seconds since construction."""
-        return time.perf_counter() - self.start
-
-    def __call__(self, message: str) -> None:
-        """Print one progress line."""
-        print(f"[{self.elapsed:6.1f} s] {message}", file=sys.stderr, flush=True)
 
 
 def measure_first_calls(config: BenchConfig, log: Progress) -> dict[str, Any]:
@@ -232,7 +220,7 @@ def _first_call_table(first: dict[str, Any]) -> str:
         ]
         for name in names
     ]
-    return report._markdown(header, rows)
+    return report.markdown_table(header, rows)
 
 
 def run(config: BenchConfig, output: Path, quick: bool) -> str:
@@ -261,16 +249,11 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
         aggregates, SIZE_STUDY_COLUMNS, output / "solvers_residual_vs_size.png"
     )
     report.plot_ratios(rows, output / "lemke_vs_quantecon.png")
-    record["machine"]["load_average_at_end"] = _load_average()
+    record["machine"]["load_average_at_end"] = load_average()
     record["run_time_s"] = log.elapsed
     report.write_json(record, output / "solvers.json")
     log(f"done in {log.elapsed:.0f} s; wrote solvers.json and 3 plots to {output}")
     return markdown_report(record, aggregates, summary)
-
-
-def _load_average() -> list[float] | None:
-    """The 1/5/15-minute load averages, where the platform has them."""
-    return list(os.getloadavg()) if hasattr(os, "getloadavg") else None
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -184,8 +184,33 @@ def _git_commit() -> str | None:
     return process.stdout.strip()
 
 
-def machine_info() -> dict[str, Any]:
-    """Platform, CPU, load, library versions and the date, for the JSON record."""
+VERSIONED_PACKAGES = ("numpy", "scipy", "numba", "llvmlite", "quantecon", "mdi-envs")
+"""Distributions whose versions ``machine_info`` records by default."""
+
+
+def load_average() -> list[float] | None:
+    """The 1/5/15-minute load averages, where the platform has them."""
+    return list(os.getloadavg()) if hasattr(os, "getloadavg") else None
+
+
+class Progress:
+    """Progress lines on stderr, stamped with the seconds since the start of the run."""
+
+    def __init__(self) -> None:
+        self.start = time.perf_counter()
+
+    @property
+    def elapsed(self) -> float:
+        """Seconds since construction."""
+        return time.perf_counter() - self.start
+
+    def __call__(self, message: str) -> None:
+        """Print one progress line."""
+        print(f"[{self.elapsed:6.1f} s] {message}", file=sys.stderr, flush=True)
+
+
+def machine_info(packages: tuple[str, ...] = VERSIONED_PACKAGES) -> dict[str, Any]:
+    """Platform, CPU, load, versions of ``packages`` and the date, for the JSON record."""
     return {
         "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
         "platform": platform.platform(),
@@ -193,13 +218,19 @@ def machine_info() -> dict[str, Any]:
         "cpu_model": _cpu_model(),
         "cpu_count": os.cpu_count(),
         "cpu_affinity": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None,
-        "load_average_at_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
-        "versions": {
-            name: _package_version(name)
-            for name in ("numpy", "scipy", "numba", "llvmlite", "quantecon", "mdi-envs")
-        },
+        "load_average_at_start": load_average(),
+        "versions": {name: _package_version(name) for name in packages},
         "git_commit": _git_commit(),
     }
 
 
-__all__ = ["Timed", "TimingPlan", "machine_info", "probe_first_calls", "time_interleaved"]
+__all__ = [
+    "VERSIONED_PACKAGES",
+    "Progress",
+    "Timed",
+    "TimingPlan",
+    "load_average",
+    "machine_info",
+    "probe_first_calls",
+    "time_interleaved",
+]

@@ -1,0 +1,580 @@
+"""Engine benchmark: µs per Moreau-Jean step, single and batched, the shortcuts, and MuJoCo.
+
+Usage (from the repository root)::
+
+    python -m benchmarks.engine --output results/bench
+    python -m benchmarks.engine --output /tmp/bench --quick   # manipulator only, ~20 s, for tests
+
+Writes ``engine.json``, ``engine_batched.png``, ``engine_single_step.png`` and
+``engine_shortcuts.png`` to the output folder, prints progress lines on stderr and the Markdown
+results tables (the ones in ``benchmarks/README.md``) on stdout. Parts:
+
+1. compile: the first ``step`` and ``step_batch`` call of every stepper (numba JIT), timed once
+   and excluded from everything else;
+2. single step: ``MoreauJeanStepper.step`` from Python per scene, the compiled kernel called
+   from Python with preallocated arrays (the dispatch cost alone), the in-kernel cost per step
+   (``step_batch`` on N copies of the one scene), and MuJoCo's ``mj_step`` / ``rollout``;
+3. batched: µs per copy-step of ``step_batch`` on each model's scene mix for N = 1 ... 4096,
+   each call lasting at least ``call_s``, interleaved with MuJoCo's single-thread ``rollout``;
+4. shortcuts: each exact shortcut of ``StepShortcuts`` on vs off on the same scene (batched),
+   and the cost of a step with a closed contact / engaged brake against a free one;
+5. brake stop: steps until the relative velocity is below 1 % after the brake engages at
+   1 rad/s, ours against MuJoCo's soft equality constraint.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks import engine_report as R
+from benchmarks import report
+from benchmarks.engine_mujoco import SCENES as MUJOCO_SCENES
+from benchmarks.engine_mujoco import MujocoArm, import_mujoco
+from benchmarks.engine_scenes import (
+    MANIPULATOR_Q,
+    TIME_STEP,
+    BatchedCall,
+    ModelCase,
+    batch_arrays,
+    calibrate_substeps,
+    model_cases,
+    stepper,
+)
+from benchmarks.timing import (
+    VERSIONED_PACKAGES,
+    Progress,
+    TimingPlan,
+    load_average,
+    machine_info,
+    time_interleaved,
+)
+from mdi_envs.mechanics.compiled import compile_equations
+from mdi_envs.stepping import MoreauJeanStepper, StepShortcuts
+
+
+@dataclass(frozen=True)
+class ShortcutCase:
+    """One shortcut measurement: a scene timed with the shortcut on and off.
+
+    Attributes:
+        shortcut: the ``StepShortcuts`` field, or ``"no_solve"`` (no switch exists: a free
+            step is timed against the same model's step with a closed contact / engaged brake).
+        model: model label. scene: the scene timed with the shortcut on (the free scene for
+            ``no_solve``).
+        off: the ``StepShortcuts`` of the "off" run (for ``no_solve``: the name of the scene
+            with the solve).
+    """
+
+    shortcut: str
+    model: str
+    scene: str
+    off: StepShortcuts | str
+
+
+SKIP_ROWS_OFF = StepShortcuts(skip_frictionless_rows=False)
+REUSE_MASS_OFF = StepShortcuts(reuse_constant_mass=False)
+DIRECT_SOLVE_OFF = StepShortcuts(direct_solve_max_size=0)
+
+SHORTCUT_CASES = (
+    ShortcutCase("skip_frictionless_rows", "ball", "resting", SKIP_ROWS_OFF),
+    ShortcutCase("skip_frictionless_rows", "ball", "bouncing", SKIP_ROWS_OFF),
+    ShortcutCase("reuse_constant_mass", "ball", "resting", REUSE_MASS_OFF),
+    ShortcutCase("reuse_constant_mass", "ball", "in flight", REUSE_MASS_OFF),
+    ShortcutCase("reuse_constant_mass", "block", "sticking", REUSE_MASS_OFF),
+    ShortcutCase("reuse_constant_mass", "block", "sliding", REUSE_MASS_OFF),
+    ShortcutCase("reuse_constant_mass", "diff_drive", "rolling", REUSE_MASS_OFF),
+    ShortcutCase("reuse_constant_mass", "diff_drive", "slipping", REUSE_MASS_OFF),
+    ShortcutCase("direct_solve_max_size", "ball", "resting", DIRECT_SOLVE_OFF),
+    ShortcutCase("direct_solve_max_size", "block", "sticking", DIRECT_SOLVE_OFF),
+    ShortcutCase("direct_solve_max_size", "block", "sliding", DIRECT_SOLVE_OFF),
+    ShortcutCase("direct_solve_max_size", "manipulator", "tresca", DIRECT_SOLVE_OFF),
+    ShortcutCase("no_solve", "ball", "in flight", "resting"),
+    ShortcutCase("no_solve", "manipulator", "released", "engaged"),
+)
+"""The full run's shortcut measurements (cases of absent models are dropped)."""
+
+
+@dataclass(frozen=True)
+class EngineConfig:
+    """Models, grid and timing budgets of one run.
+
+    Attributes:
+        models: model labels (see ``engine_scenes.model_cases``).
+        copies: the N of the batched study.
+        call_s: shortest duration of one batched call (substeps are sized to reach it).
+        single_plan: timing plan of the single-step calls (interleaved, all at once).
+        batch_plan: timing plan per N of the batched study and of the per-scene timings.
+        shortcut_plan: timing plan per on/off pair of the shortcut study.
+        scene_copies: N of the per-scene in-kernel timings, the shortcut and substeps studies.
+        shortcut_cases: which shortcut measurements to run.
+        scene_min_substeps: least substeps per call in the per-scene and shortcut studies (the
+            diff-drive stepper's first substep of every call is a cold start).
+        substep_grid: substeps per call of the substeps study (empty: skip it).
+        substep_plan: timing plan of the substeps study.
+    """
+
+    models: tuple[str, ...]
+    copies: tuple[int, ...]
+    call_s: float
+    single_plan: TimingPlan
+    batch_plan: TimingPlan
+    shortcut_plan: TimingPlan
+    scene_copies: int
+    shortcut_cases: tuple[ShortcutCase, ...]
+    scene_min_substeps: int = 10
+    substep_grid: tuple[int, ...] = ()
+    substep_plan: TimingPlan = TimingPlan(budget_s=0.1, min_rounds=5, max_rounds=30,
+                                          min_batch_s=2e-3)
+
+
+FULL = EngineConfig(
+    models=("ball", "block", "manipulator", "diff_drive"),
+    copies=(1, 4, 16, 64, 256, 1024, 4096),
+    call_s=0.01,
+    single_plan=TimingPlan(budget_s=0.2, min_rounds=9, max_rounds=150, min_batch_s=2e-3),
+    batch_plan=TimingPlan(budget_s=0.3, min_rounds=9, max_rounds=31),
+    shortcut_plan=TimingPlan(budget_s=0.6, min_rounds=15, max_rounds=61),
+    scene_copies=256,
+    shortcut_cases=SHORTCUT_CASES,
+    substep_grid=(1, 10, 100),
+)
+QUICK = EngineConfig(
+    models=("manipulator",),
+    copies=(1, 64, 4096),
+    call_s=0.002,
+    single_plan=TimingPlan(budget_s=0.01, min_rounds=3, max_rounds=10, min_batch_s=5e-4),
+    batch_plan=TimingPlan(budget_s=0.01, min_rounds=3, max_rounds=5),
+    shortcut_plan=TimingPlan(budget_s=0.01, min_rounds=3, max_rounds=5),
+    scene_copies=64,
+    shortcut_cases=(ShortcutCase("no_solve", "manipulator", "released", "engaged"),),
+)
+
+TARGETS_US = {"manipulator_batched": 0.1, "manipulator_python": 1.0, "diff_drive": 2.0}
+"""The brief's targets [µs]."""
+
+
+def _seconds(action: Callable[[], Any]) -> float:
+    """Wall-clock seconds of one call."""
+    start = time.perf_counter()
+    action()
+    return time.perf_counter() - start
+
+
+def _first_batch(st: MoreauJeanStepper, case: ModelCase) -> None:
+    """One tiny ``step_batch`` call (compiles it)."""
+    BatchedCall(st, batch_arrays(case, 2), 1)()
+
+
+def compile_steppers(cases: list[ModelCase], log: Progress, notes: list[str]
+                     ) -> tuple[list[ModelCase], dict[str, MoreauJeanStepper], list[dict]]:
+    """Build each default stepper and time its first ``step`` and ``step_batch`` calls.
+
+    A model whose first call raises ``NotImplementedError`` is dropped with a note.
+
+    Returns:
+        (the cases kept, label -> stepper, one compile record per stepper).
+    """
+    kept, steppers, records = [], {}, []
+    for case in cases:
+        log(f"compiling {case.label} (first step, then first step_batch) ...")
+        try:
+            st = stepper(case)
+            arrays = case.scenes[0].arrays()
+            step_s = _seconds(lambda st=st, arrays=arrays: st.step(*arrays))
+            batch_s = _seconds(lambda st=st, case=case: _first_batch(st, case))
+        except NotImplementedError as error:
+            notes.append(f"{case.label} skipped: NotImplementedError: {error}")
+            log(notes[-1])
+            continue
+        kept.append(case)
+        steppers[case.label] = st
+        records.append({"stepper": f"{case.label} (default shortcuts)", "step_s": step_s,
+                        "step_batch_s": batch_s})
+        log(f"  {case.label}: first step {step_s:.1f} s, first step_batch {batch_s:.1f} s")
+    return kept, steppers, records
+
+
+def _raw_kernel_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
+    """The stepper's compiled kernel, called from Python with preallocated arrays.
+
+    Uses the stepper's private kernel and workspace: the public ``step`` minus its argument
+    checks and output allocation, i.e. the numba dispatch plus the step itself.
+    """
+    q, u, tau, brake = arrays
+    brake = np.zeros(st.num_brakes) if brake is None else brake
+    outputs = (np.empty(st.num_dofs), np.empty(st.num_dofs), np.empty(st.num_impulses),
+               np.empty(st._info_size))
+    args = (q, u, tau, brake, float(st.time_step), st._values, *outputs, st._workspace)
+    kernel = st._step
+    return lambda: kernel(*args)
+
+
+def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
+                      arm: MujocoArm | None, config: EngineConfig, log: Progress
+                      ) -> list[dict[str, Any]]:
+    """Per scene: ``step`` from Python, the raw kernel from Python, and MuJoCo's ``mj_step``."""
+    calls: dict[str, Callable[[], Any]] = {}
+    for case in cases:
+        st = steppers[case.label]
+        for scene in case.scenes:
+            arrays = scene.arrays()
+            calls[f"{case.label}|{scene.name}|step"] = (
+                lambda st=st, a=arrays: st.step(*a))
+            calls[f"{case.label}|{scene.name}|kernel"] = _raw_kernel_call(st, arrays)
+    if arm is not None:
+        for scene, call in arm.single_step_calls().items():
+            calls[f"mujoco|{scene}|mj_step"] = call
+    log(f"single step: {len(calls)} callables, interleaved ...")
+    timed = time_interleaved(calls, config.single_plan)
+    rows = []
+    for key, value in timed.items():
+        model, scene, entry = key.split("|")
+        rows.append({"model": model, "scene": scene, "entry": entry, **value.summary()})
+    for case in cases:
+        cells = [f"{r['scene']} {R.format_us_fine(r['median_s'])}" for r in rows
+                 if r["model"] == case.label and r["entry"] == "step"]
+        log(f"  {case.label} step() µs: " + ", ".join(cells))
+    if arm is not None:
+        cells = [f"{r['scene']} {R.format_us_fine(r['median_s'])}" for r in rows
+                 if r["model"] == "mujoco"]
+        log("  MuJoCo mj_step µs: " + ", ".join(cells))
+    return rows
+
+
+def _batched_entry(st: MoreauJeanStepper, initial: tuple, target_s: float,
+                   min_substeps: int = 1) -> BatchedCall:
+    """A ``BatchedCall`` of at least ``min_substeps`` substeps, lasting about ``target_s``+."""
+    call = BatchedCall(st, initial)
+
+    def make(substeps: int) -> BatchedCall:
+        call.num_substeps = substeps
+        return call
+
+    call.num_substeps = max(min_substeps, calibrate_substeps(make, target_s))
+    return call
+
+
+def _mujoco_entry(arm: MujocoArm, num_copies: int, target_s: float,
+                  scenes: tuple[str, ...] = MUJOCO_SCENES) -> tuple[Callable[[], Any], int]:
+    """A MuJoCo rollout call of about ``target_s`` and its number of steps."""
+    def make(steps: int) -> Callable[[], Any]:
+        return arm.rollout_call(num_copies, steps, scenes)
+
+    steps = calibrate_substeps(make, target_s, max_substeps=10**6)
+    return arm.rollout_call(num_copies, steps, scenes), steps
+
+
+def _per_copy_step(timed_summary: dict[str, Any], num_copies: int, substeps: int
+                   ) -> dict[str, Any]:
+    """A ``Timed.summary`` of one call, scaled to one copy-step."""
+    scale = 1.0 / (num_copies * substeps)
+    return {
+        "copies": num_copies,
+        "substeps": substeps,
+        "call": timed_summary,
+        "per_copy_step_s": timed_summary["median_s"] * scale,
+        "per_copy_step_q1_s": timed_summary["q1_s"] * scale,
+        "per_copy_step_q3_s": timed_summary["q3_s"] * scale,
+        "per_copy_step_min_s": timed_summary["min_s"] * scale,
+    }
+
+
+def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
+                arm: MujocoArm | None, config: EngineConfig, log: Progress
+                ) -> list[dict[str, Any]]:
+    """In-kernel µs per step of each scene: ``step_batch`` with every copy in that scene."""
+    n = config.scene_copies
+    calls: dict[str, Callable[[], Any]] = {}
+    substeps: dict[str, int] = {}
+    for case in cases:
+        for scene in case.scenes:
+            key = f"{case.label}|{scene.name}"
+            entry = _batched_entry(steppers[case.label], batch_arrays(case, n, [scene]),
+                                   config.call_s, config.scene_min_substeps)
+            calls[key], substeps[key] = entry, entry.num_substeps
+    if arm is not None:
+        for scene in MUJOCO_SCENES:
+            key = f"mujoco|{scene}"
+            calls[key], substeps[key] = _mujoco_entry(arm, n, config.call_s, (scene,))
+    log(f"in-kernel per scene (N = {n}): {len(calls)} callables, interleaved ...")
+    timed = time_interleaved(calls, config.batch_plan)
+    rows = []
+    for key, value in timed.items():
+        model, scene = key.split("|")
+        rows.append({"model": model, "scene": scene,
+                     **_per_copy_step(value.summary(), n, substeps[key])})
+    log("  " + ", ".join(f"{r['model']}/{r['scene']} {R.format_us_fine(r['per_copy_step_s'])}"
+                         for r in rows))
+    return rows
+
+
+def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
+                  arm: MujocoArm | None, config: EngineConfig, log: Progress
+                  ) -> list[dict[str, Any]]:
+    """µs per copy-step of each model's mix (and MuJoCo's) for every N, interleaved per N."""
+    rows = []
+    for n in config.copies:
+        calls: dict[str, Callable[[], Any]] = {}
+        substeps: dict[str, int] = {}
+        for case in cases:
+            entry = _batched_entry(steppers[case.label], batch_arrays(case, n), config.call_s)
+            calls[case.label], substeps[case.label] = entry, entry.num_substeps
+        if arm is not None:
+            calls["mujoco"], substeps["mujoco"] = _mujoco_entry(arm, n, config.call_s)
+        timed = time_interleaved(calls, config.batch_plan)
+        measured = [{"model": key, **_per_copy_step(value.summary(), n, substeps[key])}
+                    for key, value in timed.items()]
+        rows += measured
+        log(f"batched N = {n}: " + ", ".join(
+            f"{r['model']} {R.format_us_fine(r['per_copy_step_s'])} µs (x{r['substeps']})"
+            for r in measured) + f"; load {_load_text()}")
+    return rows
+
+
+def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
+                   config: EngineConfig, log: Progress) -> list[dict[str, Any]]:
+    """µs per copy-step of each model's mix at N = ``scene_copies`` for a few substeps per call.
+
+    Shows what a call costs beyond its steps, and the diff-drive stepper's warm start, which
+    each copy rebuilds at the start of every ``step_batch`` call (its first substep is cold).
+    """
+    if not config.substep_grid:
+        return []
+    n = config.scene_copies
+    calls: dict[tuple[str, int], BatchedCall] = {}
+    for case in cases:
+        for substeps in config.substep_grid:
+            calls[(case.label, substeps)] = BatchedCall(
+                steppers[case.label], batch_arrays(case, n), substeps)
+    log(f"substeps per call (N = {n}): {len(calls)} callables, interleaved ...")
+    timed = time_interleaved({f"{m}|{k}": c for (m, k), c in calls.items()}, config.substep_plan)
+    rows = []
+    for (model, substeps), _ in calls.items():
+        rows.append({"model": model,
+                     **_per_copy_step(timed[f"{model}|{substeps}"].summary(), n, substeps)})
+    log("  " + ", ".join(f"{r['model']} x{r['substeps']} {R.format_us_fine(r['per_copy_step_s'])}"
+                         for r in rows))
+    return rows
+
+
+def _state_difference(first: BatchedCall, second: BatchedCall) -> float:
+    """Largest |difference| of the states the two calls reach from the same initial states."""
+    first()
+    second()
+    return float(max(np.abs(first.q - second.q).max(), np.abs(first.u - second.u).max()))
+
+
+def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
+                   config: EngineConfig, log: Progress, compile_records: list[dict]
+                   ) -> list[dict[str, Any]]:
+    """Each shortcut on vs off on the same scene, batched, interleaved pair by pair."""
+    by_label = {c.label: c for c in cases}
+    variants: dict[tuple[str, StepShortcuts], MoreauJeanStepper] = {}
+    n = config.scene_copies
+    rows = []
+    for sc in config.shortcut_cases:
+        case = by_label.get(sc.model)
+        if case is None:
+            continue
+        on_arrays = batch_arrays(case, n, [case.scene(sc.scene)])
+        on = _batched_entry(steppers[case.label], on_arrays, config.call_s,
+                            config.scene_min_substeps)
+        if isinstance(sc.off, StepShortcuts):
+            key = (case.label, sc.off)
+            if key not in variants:
+                log(f"compiling {case.label} with {R.shortcuts_text(sc.off)} ...")
+                st = stepper(case, sc.off)
+                seconds = _seconds(lambda st=st, case=case: _first_batch(st, case))
+                compile_records.append({"stepper": f"{case.label} ({R.shortcuts_text(sc.off)})",
+                                        "step_s": None, "step_batch_s": seconds})
+                log(f"  first step_batch {seconds:.1f} s")
+                variants[key] = st
+            off = BatchedCall(variants[key], on_arrays, on.num_substeps)
+            difference: float | None = _state_difference(on, off)
+            off_scene = sc.scene
+        else:
+            off = _batched_entry(steppers[case.label],
+                                 batch_arrays(case, n, [case.scene(sc.off)]), config.call_s,
+                                 config.scene_min_substeps)
+            difference = None
+            off_scene = sc.off
+        timed = time_interleaved({"on": on, "off": off}, config.shortcut_plan)
+        row = {
+            "shortcut": sc.shortcut,
+            "model": sc.model,
+            "scene": sc.scene,
+            "off_scene": off_scene,
+            "off_shortcuts": sc.off._asdict() if isinstance(sc.off, StepShortcuts) else None,
+            "on": _per_copy_step(timed["on"].summary(), n, on.num_substeps),
+            "off": _per_copy_step(timed["off"].summary(), n, off.num_substeps),
+            "max_state_difference": difference,
+        }
+        row["speedup"] = row["off"]["per_copy_step_s"] / row["on"]["per_copy_step_s"]
+        row["speedup_fastest_rounds"] = (row["off"]["per_copy_step_min_s"]
+                                         / row["on"]["per_copy_step_min_s"])
+        rows.append(row)
+        log(f"shortcut {sc.shortcut} on {sc.model}/{sc.scene}: on "
+            f"{R.format_us_fine(row['on']['per_copy_step_s'])} µs, off "
+            f"{R.format_us_fine(row['off']['per_copy_step_s'])} µs"
+            f"{'' if off_scene == sc.scene else f' ({off_scene})'}, speedup "
+            f"{row['speedup']:.2f}")
+    return rows
+
+
+def brake_stop_study(steppers: dict[str, MoreauJeanStepper], arm: MujocoArm | None,
+                     log: Progress) -> dict[str, Any]:
+    """Steps to stop a 1 rad/s relative motion after the brake engages: ours and MuJoCo's."""
+    result: dict[str, Any] = {}
+    st = steppers.get("manipulator")
+    if st is not None:
+        q, u = np.zeros(2), np.array([0.0, 1.0])
+        trace = [1.0]
+        steps = None
+        for k in range(1, 101):
+            out = st.step(q, u, np.zeros(1), np.array([np.inf]))
+            q, u = out.q, out.u
+            trace.append(abs(float(u[1] - u[0])))
+            if trace[-1] < 0.01:
+                steps = k
+                break
+        result["ours"] = {"steps": steps, "relative_speed_after_first_step": trace[1],
+                          "relative_angle_at_stop": float(q[1] - q[0]),
+                          "relative_speed_trace": trace}
+    if arm is not None:
+        result["mujoco_default"] = arm.brake_stop(None)
+        result["mujoco_stiffest"] = arm.brake_stop((2 * TIME_STEP, 1.0))
+    log("brake stop (steps to |relative velocity| < 1 %): " + ", ".join(
+        f"{k} {v['steps']}" for k, v in result.items()))
+    return result
+
+
+def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, Any]]:
+    """The brief's targets against the measurements (None where the model was not run)."""
+
+    def python_worst(model: str) -> float | None:
+        values = [r["median_s"] for r in single if r["model"] == model and r["entry"] == "step"]
+        return max(values) if values else None
+
+    def batched_at_largest(model: str) -> tuple[float | None, int | None, float | None]:
+        rows = [r for r in batched if r["model"] == model]
+        if not rows:
+            return None, None, None
+        largest = max(rows, key=lambda r: r["copies"])
+        return (largest["per_copy_step_s"], largest["copies"],
+                min(r["per_copy_step_s"] for r in rows))
+
+    targets = []
+    value, copies, best = batched_at_largest("manipulator")
+    targets.append(R.target_row("manipulator, batched, µs per copy-step (mix, largest N)",
+                                TARGETS_US["manipulator_batched"], value,
+                                f"N = {copies}; best over N {R.format_us_fine(best)} µs"
+                                if best is not None else ""))
+    targets.append(R.target_row("manipulator, one step() from Python (slowest scene)",
+                                TARGETS_US["manipulator_python"], python_worst("manipulator")))
+    value, copies, best = batched_at_largest("diff_drive")
+    targets.append(R.target_row("diff-drive, batched, µs per copy-step (mix, largest N)",
+                                TARGETS_US["diff_drive"], value,
+                                f"N = {copies}; best over N {R.format_us_fine(best)} µs"
+                                if best is not None else ""))
+    targets.append(R.target_row("diff-drive, one step() from Python (slowest scene)",
+                                TARGETS_US["diff_drive"], python_worst("diff_drive")))
+    return targets
+
+
+def _load_text() -> str:
+    """The 1-minute load average, for progress lines."""
+    load = load_average()
+    return f"{load[0]:.2f}" if load else "n/a"
+
+
+def run(config: EngineConfig, output: Path, quick: bool) -> str:
+    """Run the whole benchmark, write the outputs and return the Markdown report."""
+    log = Progress()
+    output.mkdir(parents=True, exist_ok=True)
+    record: dict[str, Any] = {
+        "machine": machine_info((*VERSIONED_PACKAGES, "mujoco")),
+        "config": {"quick": quick, "time_step": TIME_STEP,
+                   **{k: v for k, v in asdict(config).items() if k != "shortcut_cases"}},
+        "notes": [],
+        "load_log": [],
+    }
+    notes = record["notes"]
+
+    def checkpoint(section: str) -> None:
+        record["load_log"].append({"section": section, "elapsed_s": log.elapsed,
+                                   "load_average": load_average()})
+
+    log(f"engine benchmark ({'quick' if quick else 'full'}) -> {output}; load {_load_text()}")
+    cases, case_notes = model_cases(config.models)
+    notes += case_notes
+    for note in case_notes:
+        log(note)
+    mujoco, mujoco_note = import_mujoco()
+    arm = MujocoArm(mujoco) if mujoco is not None else None
+    if mujoco_note:
+        notes.append(mujoco_note)
+        log(mujoco_note)
+    checkpoint("compile")
+    cases, steppers, compile_records = compile_steppers(cases, log, notes)
+    record["models"] = [R.case_record(c) for c in cases]
+    if arm is not None and "manipulator" in steppers:
+        st = steppers["manipulator"]
+        ours = np.empty((2, 2))
+        compile_equations(st.model).mass(np.array(MANIPULATOR_Q), st._values, ours)
+        record["mujoco_mass_matrix_difference"] = arm.mass_matrix_check(ours)
+        log(f"MuJoCo arm: |M_mujoco - T^T M_ours T| = "
+            f"{record['mujoco_mass_matrix_difference']:.1e}")
+    checkpoint("single step")
+    single = single_step_study(cases, steppers, arm, config, log)
+    checkpoint("per scene")
+    scenes = scene_study(cases, steppers, arm, config, log)
+    checkpoint("batched")
+    batched = batched_study(cases, steppers, arm, config, log)
+    checkpoint("substeps")
+    substeps = substeps_study(cases, steppers, config, log)
+    checkpoint("shortcuts")
+    shortcuts = shortcut_study(cases, steppers, config, log, compile_records)
+    checkpoint("brake stop")
+    brake = brake_stop_study(steppers, arm, log)
+    if arm is not None:
+        arm.close()
+    checkpoint("end")
+    record.update({
+        "compile": compile_records,
+        "single_step": single,
+        "per_scene": scenes,
+        "batched": batched,
+        "substeps": substeps,
+        "shortcuts": shortcuts,
+        "brake_stop": brake,
+        "targets": evaluate_targets(single, batched),
+    })
+    R.plot_batched(batched, substeps, TARGETS_US, output / "engine_batched.png")
+    R.plot_single_step(single, scenes, TARGETS_US, output / "engine_single_step.png")
+    R.plot_shortcuts(shortcuts, output / "engine_shortcuts.png")
+    record["machine"]["load_average_at_end"] = load_average()
+    record["run_time_s"] = log.elapsed
+    report.write_json(record, output / "engine.json")
+    log(f"done in {log.elapsed:.0f} s; wrote engine.json and 3 plots to {output}")
+    return R.markdown_report(record)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
+    parser.add_argument("--quick", action="store_true",
+                        help="manipulator and MuJoCo only, small grid and budgets (~20 s)")
+    args = parser.parse_args(argv)
+    print(run(QUICK if args.quick else FULL, args.output, args.quick))
+
+
+if __name__ == "__main__":
+    main()
