@@ -219,13 +219,32 @@ def _ratio_test(
         return -1
     threshold = pivot_tol * col_max
     tie_scale = tie_tol * b_max
-    excluded = np.zeros(0, dtype=np.bool_)  # allocated only if a noise pivot must be skipped
+    # Fast path (no degeneracy): a unique minimum ratio on an entry that is not noise.
+    best = -1
+    theta = np.inf
+    for i in range(n):
+        a = T[i, s]
+        if a > threshold:
+            ratio = T[i, rhs] / a
+            if ratio < theta:
+                theta = ratio
+                best = i
+    if best < 0:
+        return -1
+    num_ties = 0
+    for i in range(n):
+        a = T[i, s]
+        if a > threshold and T[i, rhs] - theta * a <= tie_scale:
+            num_ties += 1
+    if num_ties <= 1 and T[best, s] > pivot_tol * _row_scale(T, best, n):
+        return best
+    excluded = np.zeros(n, dtype=np.bool_)
     while True:
         best = -1
         theta = np.inf
         for i in range(n):
             a = T[i, s]
-            if a > threshold and (excluded.shape[0] == 0 or not excluded[i]):
+            if a > threshold and not excluded[i]:
                 ratio = T[i, rhs] / a
                 if ratio < theta:
                     theta = ratio
@@ -255,8 +274,6 @@ def _ratio_test(
         if kept > 0:
             num_ties = kept
             break
-        if excluded.shape[0] == 0:
-            excluded = np.zeros(n, dtype=np.bool_)
         for t in range(num_ties):
             excluded[ties[t]] = True
     if num_ties == 1:
@@ -306,7 +323,7 @@ def _is_tie(
 ) -> bool:
     """Whether row i attains the minimum ratio theta, to the scale-relative tie tolerance."""
     a = T[i, s]
-    if a <= threshold or (excluded.shape[0] > 0 and excluded[i]):
+    if a <= threshold or excluded[i]:
         return False
     return T[i, T.shape[1] - 1] - theta * a <= tie_scale
 

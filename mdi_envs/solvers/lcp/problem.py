@@ -30,6 +30,13 @@ def as_float_array(value: ArrayLike, name: str, ndim: int) -> FloatArray:
         ValueError: a non-numeric entry or the wrong number of dimensions; the message names
             ``name``.
     """
+    if (
+        type(value) is np.ndarray
+        and value.dtype == np.float64
+        and value.flags.c_contiguous
+        and value.ndim == ndim
+    ):
+        return value  # the common case, already in the required form
     try:
         if np.iscomplexobj(value):
             raise ValueError("complex entries")
