@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import numpy as np
+from numba import njit
 
 from mdi_envs._types import FloatArray
 from mdi_envs.mechanics.compiled import compile_equations
@@ -98,6 +99,7 @@ class MoreauJeanStepper:
     _step: Any = field(init=False, repr=False)
     _step_batch: Any = field(init=False, repr=False)
     _info_size: int = field(init=False, repr=False)
+    _released: FloatArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if not (isinstance(self.time_step, numbers.Real) and np.isfinite(self.time_step)
@@ -130,6 +132,7 @@ class MoreauJeanStepper:
         self.num_dofs = m.NUM_DOFS
         self.num_inputs = m.NUM_INPUTS
         self.num_brakes = m.NUM_BRAKES
+        self._released = np.zeros(self.num_brakes)
         self.num_impulses = m.NUM_CONTACTS * m.CONTACT_DIMENSION + m.NUM_BRAKES
 
     def step(
@@ -148,7 +151,11 @@ class MoreauJeanStepper:
         q_arr = self._vector(q, "q", self.num_dofs)
         u_arr = self._vector(u, "u", self.num_dofs)
         tau_arr = self._vector(tau, "tau", self.num_inputs)
-        brake = self._brake(brake_bound, (self.num_brakes,))
+        brake = (self._released if brake_bound is None
+                 else self._vector(brake_bound, "brake_bound", self.num_brakes))
+        problem = _screen_inputs(q_arr, u_arr, tau_arr, brake)
+        if problem:
+            raise ValueError(_INPUT_PROBLEMS[problem])
         q_out, u_out = np.empty(self.num_dofs), np.empty(self.num_dofs)
         impulses, info = np.empty(self.num_impulses), np.empty(self._info_size)
         self._step(q_arr, u_arr, tau_arr, brake, float(self.time_step), self._values,
@@ -157,7 +164,7 @@ class MoreauJeanStepper:
         if self._info_size == SPATIAL_INFO_SIZE:
             mode, lifted = int(info[INFO_MODE]), int(info[INFO_LIFTED_CONTACTS])
         return StepResult(
-            q_out, u_out, impulses, SolverStatus(int(info[INFO_STATUS])),
+            q_out, u_out, impulses, _STATUS_OF_CODE[int(info[INFO_STATUS])],
             int(info[INFO_ITERATIONS]), int(info[INFO_ACTIVE_CONTACTS]),
             int(info[INFO_LCP_SIZE]), int(info[INFO_EQUALITIES]), mode, lifted,
         )
@@ -215,12 +222,12 @@ class MoreauJeanStepper:
 
     @staticmethod
     def _vector(value: Any, name: str, size: int) -> FloatArray:
-        array = np.ascontiguousarray(value, dtype=np.float64)
-        if array.shape != (size,):
-            raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
-        if not np.isfinite(array).all():
-            raise ValueError(f"{name} contains NaN or inf entries: {array}")
-        return array
+        if not (type(value) is np.ndarray and value.dtype == np.float64
+                and value.flags.c_contiguous):
+            value = np.ascontiguousarray(value, dtype=np.float64)
+        if value.shape != (size,):
+            raise ValueError(f"{name} must have shape ({size},), got {value.shape}")
+        return value
 
     @staticmethod
     def _brake(value: Any, shape: tuple[int, ...]) -> FloatArray:
@@ -232,6 +239,34 @@ class MoreauJeanStepper:
         if np.isnan(array).any() or (array < 0.0).any():
             raise ValueError("brake_bound must be >= 0 (0 released, inf ideal), got NaN or < 0")
         return array
+
+
+_STATUS_OF_CODE = tuple(SolverStatus)
+_INPUT_PROBLEMS = (
+    "",
+    "q contains NaN or inf entries",
+    "u contains NaN or inf entries",
+    "tau contains NaN or inf entries",
+    "brake_bound must be >= 0 (0 released, inf ideal), got NaN or < 0",
+)
+
+
+@njit(cache=True)
+def _screen_inputs(q: FloatArray, u: FloatArray, tau: FloatArray, brake: FloatArray) -> int:
+    """0 if the step's inputs are valid, else the index of the problem in ``_INPUT_PROBLEMS``."""
+    for v in q:
+        if not np.isfinite(v):
+            return 1
+    for v in u:
+        if not np.isfinite(v):
+            return 2
+    for v in tau:
+        if not np.isfinite(v):
+            return 3
+    for v in brake:
+        if not v >= 0.0:
+            return 4
+    return 0
 
 
 __all__ = ["MoreauJeanStepper", "StepResult"]
