@@ -131,21 +131,62 @@ def _make_carver(layout: Layout) -> Any:
     return njit(namespace["carve"])
 
 
+def make_free_motion(
+    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts
+) -> Any:
+    """Compile the smooth part of the step shared by the planar and the spatial kernels.
+
+    ``free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)`` writes
+    q_M = q + dt/2 u and u_free = u + M(q_M)^-1 (h(q_M, u) + B tau) dt (all arrays modified in
+    place; M^-1 is kept across steps when the model's mass is constant and the shortcut is on)
+    and returns False if M(q_M) is singular.
+    """
+    n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
+    mass, forces, inputs = eq.mass, eq.forces, eq.inputs
+    reuse_mass = shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
+
+    @njit
+    def free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col,  # noqa: ANN001
+                    mass_ready):
+        for i in range(n):
+            qm[i] = q[i] + 0.5 * dt * u[i]
+        forces(qm, u, p, h)
+        inputs(qm, p, B)
+        ok = True
+        if not (reuse_mass and mass_ready[0] == 1):
+            mass(qm, p, M)
+            ok = invert_into(M, Minv, Mwork, col)
+            mass_ready[0] = 1 if ok else 0
+        for i in range(n):
+            f = h[i]
+            for j in range(num_inputs):
+                f += B[i, j] * tau[j]
+            col[i] = f * dt
+        for i in range(n):
+            acc = u[i]
+            for j in range(n):
+                acc += Minv[i, j] * col[j]
+            ufree[i] = acc
+        return ok
+
+    return free_motion
+
+
 def make_step_kernels(
     model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts
 ) -> tuple[Any, Any]:
     """Compile ``step(...)`` and ``step_batch(...)`` for ``model`` (see their docstrings)."""
-    n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
+    n = model.NUM_DOFS
     c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
     if c > 0 and d != 2:
         raise NotImplementedError(
             f"{model.__name__}: contact_dimension {d}; the LCP step handles planar contacts"
         )
-    mass, forces, inputs, gaps = eq.mass, eq.forces, eq.inputs, eq.gaps
+    gaps = eq.gaps
     contact_rows, brake_rows = eq.contact_rows, eq.brake_rows
     restitutions, friction_coefficients = eq.restitutions, eq.friction_coefficients
     keep_frictionless_rows = not shortcuts.skip_frictionless_rows
-    reuse_mass = shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
+    free_motion = make_free_motion(model, eq, shortcuts)
     direct_solve_max_size = shortcuts.direct_solve_max_size
     float_layout, _, int_layout, _ = _workspace_layout(model)
     carve_floats = _make_carver(float_layout)
@@ -170,25 +211,7 @@ def make_step_kernels(
          A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P, Mwork,
          col) = fs
         basis, row_of, slot_of, slot_var, row_ref, mass_ready = js
-        for i in range(n):
-            qm[i] = q[i] + 0.5 * dt * u[i]
-        forces(qm, u, p, h)
-        inputs(qm, p, B)
-        ok = True
-        if not (reuse_mass and mass_ready[0] == 1):
-            mass(qm, p, M)
-            ok = invert_into(M, Minv, Mwork, col)
-            mass_ready[0] = 1 if ok else 0
-        for i in range(n):
-            f = h[i]
-            for j in range(num_inputs):
-                f += B[i, j] * tau[j]
-            col[i] = f * dt
-        for i in range(n):
-            acc = u[i]
-            for j in range(n):
-                acc += Minv[i, j] * col[j]
-            ufree[i] = acc
+        ok = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
         for i in range(c * d + k):
             impulses[i] = 0.0
         info[INFO_STATUS] = CODE_CONVERGED if ok else CODE_BREAKDOWN
@@ -473,6 +496,7 @@ __all__ = [
     "IDEAL_BRAKE_IMPULSE",
     "INFO_STATUS",
     "StepShortcuts",
+    "make_free_motion",
     "make_step_kernels",
     "make_workspace",
 ]

@@ -52,7 +52,6 @@ from numba import njit
 
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
-from mdi_envs.solvers._linalg import invert_into
 from mdi_envs.solvers.fc3d.newton_ac import make_workspace as make_newton_workspace
 from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED
@@ -64,6 +63,7 @@ from mdi_envs.stepping._kernel import (
     INFO_SIZE,
     INFO_STATUS,
     StepShortcuts,
+    make_free_motion,
 )
 
 # The spatial step's diagnostics extend the planar layout (same meaning of entries 0..4;
@@ -111,7 +111,7 @@ def make_spatial_step_kernels(
     Raises:
         NotImplementedError: the model is not spatial, has brakes, or lacks ``normal_loads``.
     """
-    n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
+    n = model.NUM_DOFS
     c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
     if d != 3 or c == 0:
         raise NotImplementedError(f"{model.__name__}: the spatial step needs 3-D contacts")
@@ -122,11 +122,10 @@ def make_spatial_step_kernels(
             f"{model.__name__}: the spatial step needs normal loads N = N0 + K F "
             "(unilateral 3-D contacts with normal rows are not implemented)"
         )
-    mass, forces, inputs = eq.mass, eq.forces, eq.inputs
     contact_rows, friction_coefficients = eq.contact_rows, eq.friction_coefficients
     normal_loads = njit(model.normal_loads)
     slip_mode = njit(model.slip_mode)
-    reuse_mass = shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
+    free_motion = make_free_motion(model, eq, shortcuts)
     c2 = 2 * c
     c3 = 3 * c
 
@@ -144,25 +143,7 @@ def make_spatial_step_kernels(
         """
         (qm, M, Minv, h, B, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho, Mwork,
          col, sliding, nws, mass_ready, r_best, warm, warm_ready) = ws
-        for i in range(n):
-            qm[i] = q[i] + 0.5 * dt * u[i]
-        forces(qm, u, p, h)
-        inputs(qm, p, B)
-        ok = True
-        if not (reuse_mass and mass_ready[0] == 1):
-            mass(qm, p, M)
-            ok = invert_into(M, Minv, Mwork, col)
-            mass_ready[0] = 1 if ok else 0
-        for i in range(n):
-            f = h[i]
-            for j in range(num_inputs):
-                f += B[i, j] * tau[j]
-            col[i] = f * dt
-        for i in range(n):
-            acc = u[i]
-            for j in range(n):
-                acc += Minv[i, j] * col[j]
-            ufree[i] = acc
+        ok = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
         for i in range(c3):
             impulses[i] = 0.0
         info[INFO_STATUS] = CODE_CONVERGED
