@@ -8,7 +8,7 @@ VENV ?= .venv
 TORCH_SPEC ?=
 BIN := $(VENV)/bin
 
-.PHONY: demo test bench install-% lint clean
+.PHONY: demo test bench lint clean
 
 # Install the package in editable mode with the given extras, once per extras set and pyproject.
 $(VENV)/.installed-%: pyproject.toml
