@@ -86,10 +86,12 @@ def _workspace_layout(model: type[ModelDefinition]) -> tuple[Layout, int, Layout
         "Mred": (lcp, lcp), "qred": (lcp,), "z": (lcp,), "T": (lcp, lcp + 2),
         "pivot_row": (lcp + 2,), "Aee": (k, k), "Aee_inv": (k, k), "lu_work": (k, k),
         "lu_col": (k,), "v": (size,), "P": (rows,), "Mwork": (n, n), "col": (n,),
+        "row_eps": (rows,),
     }
     int_shapes: dict[str, tuple[int, ...]] = {
         "basis": (lcp,), "row_of": (2 * lcp + 1,), "slot_of": (2 * lcp + 1,),
-        "slot_var": (lcp + 1,), "row_ref": (rows,), "mass_ready": (1,),
+        "slot_var": (lcp + 1,), "row_ref": (rows,), "row_var": (rows,),
+        "mass_ready": (1,),
     }
 
     def offsets(shapes: dict[str, tuple[int, ...]]) -> tuple[Layout, int]:
@@ -209,8 +211,8 @@ def make_step_kernels(
         """
         (qm, M, Minv, h, B, ufree, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree, gpre, S, s0,
          A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P, Mwork,
-         col) = fs
-        basis, row_of, slot_of, slot_var, row_ref, mass_ready = js
+         col, row_eps) = fs
+        basis, row_of, slot_of, slot_var, row_ref, row_var, mass_ready = js
         ok = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
         for i in range(c * d + k):
             impulses[i] = 0.0
@@ -294,6 +296,8 @@ def make_step_kernels(
             a[r] = 0.0
             for s in range(size):
                 A[r, s] = 0.0
+        # One pass fills S, s0, the constant entries of A and a, and for each impulse row r
+        # the MLCP row its xi feeds (row_var) and its restitution (row_eps).
         r = 0
         x = 0
         y = num_x
@@ -301,10 +305,15 @@ def make_step_kernels(
             if g[i] > GAP_TOLERANCE:
                 continue
             S[r, x] = 1.0
+            row_var[r] = x
+            row_eps[r] = eps[i]
             if mu[i] > 0.0 or keep_frictionless_rows:
                 S[r + 1, x] = -mu[i]
                 S[r + 1, x + 1] = 1.0
-                A[x + 2, x] = 2.0 * mu[i]
+                row_var[r + 1] = x + 1
+                row_eps[r + 1] = 0.0
+                A[x + 1, x + 2] = 1.0  # xi_R = xi_T + xi_L
+                A[x + 2, x] = 2.0 * mu[i]  # P_L = 2 mu P_N - P_R
                 A[x + 2, x + 1] = -1.0
                 x += 3
                 r += 2
@@ -315,44 +324,23 @@ def make_step_kernels(
             bound = brake_bound[b]
             if bound <= 0.0:
                 continue
+            row_eps[r] = 0.0
             if bound * dt >= IDEAL_BRAKE_IMPULSE:
                 S[r, y] = 1.0
+                row_var[r] = y
                 y += 1
             else:
                 S[r, x] = 1.0
                 s0[r] = -bound * dt
-                x += 2
-            r += 1
-        # The rows of xi = G (S v + s0) + b, now that S and s0 are complete.
-        r = 0
-        x = 0
-        y = num_x
-        for i in range(c):
-            if g[i] > GAP_TOLERANCE:
-                continue
-            _set_row(A, a, x, G, S, s0, gfree, gpre, r, eps[i], num_rows, size)
-            if mu[i] > 0.0 or keep_frictionless_rows:
-                _set_row(A, a, x + 1, G, S, s0, gfree, gpre, r + 1, 0.0, num_rows, size)
-                A[x + 1, x + 2] += 1.0
-                x += 3
-                r += 2
-            else:
-                x += 1
-                r += 1
-        for b in range(k):
-            bound = brake_bound[b]
-            if bound <= 0.0:
-                continue
-            if bound * dt >= IDEAL_BRAKE_IMPULSE:
-                _set_row(A, a, y, G, S, s0, gfree, gpre, r, 0.0, num_rows, size)
-                y += 1
-            else:
-                _set_row(A, a, x, G, S, s0, gfree, gpre, r, 0.0, num_rows, size)
-                A[x, x + 1] += 1.0
-                A[x + 1, x] = -1.0
+                row_var[r] = x
+                A[x, x + 1] = 1.0  # xi_R = xi_B + xi_L
+                A[x + 1, x] = -1.0  # P_L = 2 a dt - P_R
                 a[x + 1] = 2.0 * bound * dt
                 x += 2
             r += 1
+        # The rows of xi = G (S v + s0) + b, now that S and s0 are complete.
+        for r in range(num_rows):
+            _add_row(A, a, row_var[r], G, S, s0, gfree, gpre, r, row_eps[r], num_rows, size)
 
         code, iterations = _solve_mlcp(
             A, a, num_x, num_eq, direct_solve_max_size, v, Mred, qred, z, T, basis, row_of,
@@ -414,17 +402,17 @@ def make_step_kernels(
 
 
 @njit(cache=True)
-def _set_row(A, a, row, G, S, s0, gfree, gpre, r, eps, num_rows, size):  # noqa: ANN001
-    """A[row, :] = (G S)[r, :] and a[row] = (G s0)[r] + gfree[r] + eps gpre[r] (xi of row r)."""
+def _add_row(A, a, row, G, S, s0, gfree, gpre, r, eps, num_rows, size):  # noqa: ANN001
+    """A[row, :] += (G S)[r, :] and a[row] += (G s0)[r] + gfree[r] + eps gpre[r] (xi of row r)."""
     for s in range(size):
         acc = 0.0
         for t in range(num_rows):
             acc += G[r, t] * S[t, s]
-        A[row, s] = acc
+        A[row, s] += acc
     acc = gfree[r] + eps * gpre[r]
     for t in range(num_rows):
         acc += G[r, t] * s0[t]
-    a[row] = acc
+    a[row] += acc
 
 
 @njit(cache=True)
