@@ -5,10 +5,11 @@ This is the one place where impulses and complementarity variables are mapped to
 DESIGN.md section 2, per step of length dt:
 
     q_M = q + dt/2 u
-    M(q_M) (u+ - u) = (h(q_M, u) + B tau) dt + W P
+    M(q_M) (u+ - u) = (h(q_M, u) + theta J (u+ - u) + B tau) dt + W P,   J = dh/du(q_M, u)
     q+ = q_M + dt/2 u+
 
-with the laws on xi = W^T u+ + eps W^T u for the contacts closed at q_M (g_i(q_M) <= 0) and
+with theta = 1/2 (see ``make_free_motion``; the term vanishes when h does not depend on u)
+and the laws on xi = W^T u+ + eps W^T u for the contacts closed at q_M (g_i(q_M) <= 0) and
 for the active brakes. Planar Coulomb friction and Tresca brakes become LCP rows by splitting
 the set-valued sign: P_R = mu P_N + P_T >= 0, P_L = mu P_N - P_T >= 0, xi_T = xi_R - xi_L
 (paper eqs. 17-21, 32-33). An ideal brake is an equality row xi_B = 0 with P_B free, eliminated
@@ -139,13 +140,25 @@ def make_free_motion(
     """Compile the smooth part of the step shared by the planar and the spatial kernels.
 
     ``free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)`` writes
-    q_M = q + dt/2 u and u_free = u + M(q_M)^-1 (h(q_M, u) + B tau) dt (all arrays modified in
-    place; M^-1 is kept across steps when the model's mass is constant and the shortcut is on)
-    and returns False if M(q_M) is singular.
+    q_M = q + dt/2 u and u_free = u + M_theta^-1 (h(q_M, u) + B tau) dt, where the iteration
+    matrix M_theta = M(q_M) - theta dt dh/du(q_M, u) with theta = 1/2 (M_theta = M when h does
+    not depend on u), into ``M`` and its inverse into ``Minv``. All arrays are modified in place;
+    M^-1 is kept across steps when the model's mass is constant, h independent of u and the
+    shortcut on. Returns False if M_theta is singular.
+
+    The theta term makes velocity-dependent forces linearly implicit (the theta-method of
+    Siconos' MoreauJeanOSI): the step then solves M(q_M)(u+ - u) = (h + theta J (u+ - u) + B tau)
+    dt + W P, with J = dh/du, which for the quadratic Coriolis/centrifugal forces of a Lagrangian
+    model is h evaluated bilinearly in u and u+. The explicit form (theta = 0) pumps energy and
+    angular momentum into a spinning manipulator (+89 % energy over 50 s at dt = 0.01 s); this
+    form keeps the drift at O(dt^2) (4e-5). J's columns are the exact central differences
+    (h(u + e_j) - h(u - e_j)) / 2 of a function at most quadratic in u.
     """
     n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
     mass, forces, inputs = eq.mass, eq.forces, eq.inputs
-    reuse_mass = shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
+    velocity_forces = model.HAS_VELOCITY_FORCES
+    reuse_mass = (shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
+                  and not velocity_forces)
 
     @njit
     def free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col,  # noqa: ANN001
@@ -157,6 +170,17 @@ def make_free_motion(
         ok = True
         if not (reuse_mass and mass_ready[0] == 1):
             mass(qm, p, M)
+            if velocity_forces:
+                # M -= theta dt J with theta = 1/2; probes in ufree, col and Mwork[0].
+                for j in range(n):
+                    for i in range(n):
+                        ufree[i] = u[i]
+                    ufree[j] = u[j] + 1.0
+                    forces(qm, ufree, p, col)
+                    ufree[j] = u[j] - 1.0
+                    forces(qm, ufree, p, Mwork[0])
+                    for i in range(n):
+                        M[i, j] -= 0.25 * dt * (col[i] - Mwork[0, i])
             ok = invert_into(M, Minv, Mwork, col)
             mass_ready[0] = 1 if ok else 0
         for i in range(n):

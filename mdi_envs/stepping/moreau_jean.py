@@ -176,6 +176,7 @@ class MoreauJeanStepper:
         tau: Any,
         brake_bound: Any = None,
         num_substeps: int = 1,
+        check_inputs: bool = True,
     ) -> tuple[FloatArray, FloatArray]:
         """Advance N copies in place by ``num_substeps`` steps each, in one compiled call.
 
@@ -183,6 +184,10 @@ class MoreauJeanStepper:
             q: (N, n) float64 C-contiguous, overwritten. u: (N, n), overwritten.
             tau: (N, m) inputs. brake_bound: (N, k) bounds (default: all released).
             num_substeps: steps per call (>= 1).
+            check_inputs: validate every argument (default). ``False`` is for callers that
+                own arrays of the right shapes, dtypes and values (the vector environments):
+                then tau and brake_bound must be C-contiguous float64 arrays, and nothing is
+                checked.
 
         Returns:
             (impulses (N, c*d + k), info (N, INFO_SIZE)) of each copy's last step; the status
@@ -193,6 +198,12 @@ class MoreauJeanStepper:
         Raises:
             ValueError: wrong shapes or dtypes, NaN/inf inputs, negative brake bounds.
         """
+        if not check_inputs:
+            impulses = np.empty((q.shape[0], self.num_impulses))
+            info = np.empty((q.shape[0], self._info_size))
+            self._step_batch(q, u, tau, brake_bound, float(self.time_step), self._values,
+                             int(num_substeps), impulses, info, self._workspace)
+            return impulses, info
         for name, array in (("q", q), ("u", u)):
             if not (isinstance(array, np.ndarray) and array.dtype == np.float64
                     and array.flags.c_contiguous and array.ndim == 2

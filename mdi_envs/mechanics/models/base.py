@@ -41,6 +41,9 @@ class ModelDefinition:
     NUM_BRAKES: ClassVar[int] = 0
     HAS_CONSTANT_MASS: ClassVar[bool] = False
     HAS_LOAD_TRANSFER: ClassVar[bool] = False  # normal impulses from ``normal_loads``, not gaps
+    # h depends on u (Coriolis, centrifugal, damping): at most quadratically, as in any
+    # Lagrangian model. The stepper then treats it by the theta = 1/2 scheme (moreau_jean.py).
+    HAS_VELOCITY_FORCES: ClassVar[bool] = True
     COORDINATE_NAMES: ClassVar[tuple[str, ...]]
 
     @staticmethod

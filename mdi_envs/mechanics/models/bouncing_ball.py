@@ -66,6 +66,7 @@ class BouncingBall(ModelDefinition):
     NUM_CONTACTS = 1
     CONTACT_DIMENSION = 2
     HAS_CONSTANT_MASS = True
+    HAS_VELOCITY_FORCES = False
     COORDINATE_NAMES = ("x", "y")
     Parameters = BouncingBallParameters
 

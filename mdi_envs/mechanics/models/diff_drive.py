@@ -113,6 +113,7 @@ class DiffDriveRobot(ModelDefinition):
     NUM_CONTACTS = 3
     CONTACT_DIMENSION = 3
     HAS_CONSTANT_MASS = True
+    HAS_VELOCITY_FORCES = False
     HAS_LOAD_TRANSFER = True
     COORDINATE_NAMES = ("x", "y", "phi", "psi_L", "psi_R")
     Parameters = DiffDriveParameters

@@ -70,6 +70,7 @@ class SlidingBlock(ModelDefinition):
     NUM_CONTACTS = 1
     CONTACT_DIMENSION = 2
     HAS_CONSTANT_MASS = True
+    HAS_VELOCITY_FORCES = False
     COORDINATE_NAMES = ("s", "n")
     Parameters = SlidingBlockParameters
 
