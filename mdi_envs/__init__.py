@@ -1,9 +1,14 @@
 """mdi-envs: nonsmooth rigid-body mechanics (Moreau-Jean MDIs) for control and RL.
 
-Layers: ``solvers`` (complementarity problems), then the mechanics models, the time-stepper and
-the Gymnasium environments as they land.
+Layers: ``solvers`` (complementarity problems), ``mechanics`` (the models), ``stepping`` (the
+Moreau-Jean stepper) and ``envs`` (Gymnasium environments). Importing the package registers the
+``mdi_envs/...`` environment ids, so ``gym.make("mdi_envs/BlockableManipulator-v0")`` works.
 """
+
+from mdi_envs.registration import ENV_IDS, register_envs
 
 __version__ = "0.1.0"
 
-__all__ = ["__version__"]
+register_envs()
+
+__all__ = ["ENV_IDS", "__version__"]

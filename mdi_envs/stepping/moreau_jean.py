@@ -135,6 +135,19 @@ class MoreauJeanStepper:
         self._released = np.zeros(self.num_brakes)
         self.num_impulses = m.NUM_CONTACTS * m.CONTACT_DIMENSION + m.NUM_BRAKES
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickle as the constructor's arguments.
+
+        Compiled kernels and scratch arrays are rebuilt on loading; the spatial step's warm
+        start is not carried over.
+        """
+        return (type(self), (self.model, self.parameters, self.time_step, self.shortcuts))
+
+    @property
+    def info_size(self) -> int:
+        """Columns of the per-copy diagnostics ``step_batch`` returns."""
+        return self._info_size
+
     def step(
         self, q: Any, u: Any, tau: Any, brake_bound: Any = None
     ) -> StepResult:
@@ -177,6 +190,7 @@ class MoreauJeanStepper:
         brake_bound: Any = None,
         num_substeps: int = 1,
         check_inputs: bool = True,
+        out: tuple[FloatArray, FloatArray] | None = None,
     ) -> tuple[FloatArray, FloatArray]:
         """Advance N copies in place by ``num_substeps`` steps each, in one compiled call.
 
@@ -188,6 +202,8 @@ class MoreauJeanStepper:
                 own arrays of the right shapes, dtypes and values (the vector environments):
                 then tau and brake_bound must be C-contiguous float64 arrays, and nothing is
                 checked.
+            out: preallocated (impulses, info) arrays to write into, shapes as returned
+                (only with ``check_inputs=False``; default: new arrays).
 
         Returns:
             (impulses (N, c*d + k), info (N, INFO_SIZE)) of each copy's last step; the status
@@ -199,8 +215,10 @@ class MoreauJeanStepper:
             ValueError: wrong shapes or dtypes, NaN/inf inputs, negative brake bounds.
         """
         if not check_inputs:
-            impulses = np.empty((q.shape[0], self.num_impulses))
-            info = np.empty((q.shape[0], self._info_size))
+            if out is None:
+                out = (np.empty((q.shape[0], self.num_impulses)),
+                       np.empty((q.shape[0], self._info_size)))  # fmt: skip
+            impulses, info = out
             self._step_batch(q, u, tau, brake_bound, float(self.time_step), self._values,
                              int(num_substeps), impulses, info, self._workspace)
             return impulses, info

@@ -1,0 +1,549 @@
+"""The environment base classes: one batched task behind a single and a vector Gymnasium env.
+
+Everything scene-specific -- spaces, action decoding, observations, goal distance, success --
+lives in a ``MoreauJeanTask`` written once for a batch of N copies. ``MoreauJeanEnv`` runs it
+with N = 1 and ``MoreauJeanVectorEnv`` with N = ``num_envs``; both advance the physics through
+the same compiled ``MoreauJeanStepper.step_batch`` call, so the vector env equals a
+``SyncVectorEnv`` of the single env step for step. The reward is assembled here, the same for
+every task:
+
+    reward = reward_objective + reward_shaping + reward_goal
+    reward_objective = -dt                       (objective "time")
+                     = -effort_weight sum(tau^2) dt   (objective "effort")
+    reward_shaping   = gamma Phi(s') - Phi(s),   Phi = -shaping_weight * distance_to_goal,
+                       with Phi(s') = 0 when the episode terminates (Ng et al. 1999: the optimal
+                       policy of the discounted task with discount gamma is unchanged)
+    reward_goal      = -goal_weight * distance_to_goal, once, when a fixed horizon ends.
+
+The per-copy scene functions (observation, goal distance, success) are plain Python on scalars
+and small arrays, compiled with numba into one batched kernel per task class, so that a single
+``env.step`` costs two compiled calls (physics, then rewards and observations).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+from numba import njit
+
+from mdi_envs._types import BoolArray, FloatArray
+from mdi_envs.mechanics.models.base import ModelDefinition
+from mdi_envs.stepping._kernel import (
+    INFO_ACTIVE_CONTACTS,
+    INFO_ITERATIONS,
+    INFO_STATUS,
+    StepShortcuts,
+)
+from mdi_envs.stepping.moreau_jean import MoreauJeanStepper
+
+BASE_INFO_KEYS = (
+    "reward_objective", "reward_shaping", "reward_goal", "distance_to_goal", "is_success",
+    "elapsed_time", "effort", "solver_status", "solver_iterations", "num_active_contacts",
+)
+"""``info`` entries of every scene (units: reward terms -, distance -, elapsed_time s, effort
+N^2 m^2 s; solver_status a ``SolverStatus`` code, 0 = converged, the worst over the substeps)."""
+_INFO_TYPES: dict[str, Any] = {
+    "is_success": bool, "brake_engaged": bool, "solver_status": int, "solver_iterations": int,
+    "num_active_contacts": int, "slip_mode": int, "num_lifted_contacts": int,
+}
+
+
+def _require(condition: bool, message: str) -> None:
+    if not condition:
+        raise ValueError(message)
+
+
+def _positive(name: str, value: Any) -> float:
+    _require(isinstance(value, (int, float)) and not isinstance(value, bool)
+             and math.isfinite(value) and value > 0, f"{name} must be a finite number > 0, "
+             f"got {value!r}")  # fmt: skip
+    return float(value)
+
+
+def _nonnegative(name: str, value: Any) -> float:
+    _require(isinstance(value, (int, float)) and not isinstance(value, bool)
+             and math.isfinite(value) and value >= 0, f"{name} must be a finite number >= 0, "
+             f"got {value!r}")  # fmt: skip
+    return float(value)
+
+
+class MoreauJeanTask:
+    """Scene logic of one environment family, batched over N copies.
+
+    Subclasses set ``MODEL``, ``NUM_OBSERVATIONS`` and ``OBJECTIVE_OPTIONS``, build the two
+    single-copy spaces and implement the compiled ``observe_one``, ``distance_one`` and
+    ``success_one`` with their ``constants``, plus ``initial_state``, ``decode_actions`` and
+    ``info_one`` with ``INFO_KEYS``. Arrays are float64 of shape (N, ...), observations float32.
+
+    Args:
+        parameters: the model's parameter dataclass (default: its defaults).
+        time_step: physics step dt [s].
+        frame_skip: physics steps per env step (the control is held over them).
+        objective: "time" (reach the goal fastest; success terminates) or "effort" (minimize
+            the integral of sum(tau^2) over a fixed horizon ``final_time``).
+        final_time: the fixed horizon [s] of the "effort" objective (ignored for "time").
+        shaping_weight: weight of the distance in the shaping potential Phi (0 disables).
+        shaping_discount: gamma of the shaping term; set it to the agent's discount.
+        goal_weight: weight of the distance at the end of a fixed horizon.
+        effort_weight: weight of sum(tau^2) dt in the "effort" objective.
+        reset_noise_scale: half-width of the uniform noise added to the start state.
+        shortcuts: the stepper's exact shortcuts (``StepShortcuts``).
+    """
+
+    MODEL: ClassVar[type[ModelDefinition]]
+    OBJECTIVE_OPTIONS: ClassVar[tuple[str, ...]] = ("time",)
+    single_observation_space: spaces.Space[Any]
+    single_action_space: spaces.Space[Any]
+
+    def __init__(
+        self,
+        *,
+        parameters: Any = None,
+        time_step: float,
+        frame_skip: int,
+        objective: str = "time",
+        final_time: float | None = None,
+        shaping_weight: float = 1.0,
+        shaping_discount: float = 0.99,
+        goal_weight: float = 10.0,
+        effort_weight: float = 1.0,
+        reset_noise_scale: float = 0.0,
+        shortcuts: StepShortcuts | None = None,
+    ) -> None:
+        self._constants_cache: FloatArray | None = None
+        self._info_keys = BASE_INFO_KEYS + self.INFO_KEYS
+        self._typed_keys = tuple(
+            (key, _INFO_TYPES[key]) for key in self._info_keys if key in _INFO_TYPES)
+        _require(isinstance(frame_skip, (int, np.integer)) and frame_skip >= 1,
+                 f"frame_skip must be a positive integer, got {frame_skip!r}")  # fmt: skip
+        _require(objective in self.OBJECTIVE_OPTIONS,
+                 f"objective must be one of {self.OBJECTIVE_OPTIONS}, got {objective!r}")
+        self.stepper = MoreauJeanStepper(
+            self.MODEL, parameters, _positive("time_step", time_step),
+            shortcuts if shortcuts is not None else StepShortcuts(),
+        )
+        self.parameters = self.stepper.parameters
+        self.frame_skip = int(frame_skip)
+        self.dt = self.stepper.time_step * self.frame_skip
+        self.objective = objective
+        self.num_horizon_steps = 0
+        if objective == "effort":
+            horizon = _positive("final_time", final_time)
+            self.num_horizon_steps = round(horizon / self.dt)
+            _require(abs(self.num_horizon_steps * self.dt - horizon) <= 1e-9 * horizon,
+                     f"final_time {horizon} s must be a whole number of env steps of "
+                     f"{self.dt} s (time_step * frame_skip)")  # fmt: skip
+        self.final_time = self.num_horizon_steps * self.dt
+        self.shaping_weight = _nonnegative("shaping_weight", shaping_weight)
+        self.shaping_discount = _positive("shaping_discount", shaping_discount)
+        _require(self.shaping_discount <= 1.0,
+                 f"shaping_discount must lie in (0, 1], got {shaping_discount!r}")
+        self.goal_weight = _nonnegative("goal_weight", goal_weight)
+        self.effort_weight = _nonnegative("effort_weight", effort_weight)
+        self.reset_noise_scale = _nonnegative("reset_noise_scale", reset_noise_scale)
+
+    @property
+    def _constants(self) -> FloatArray:
+        if self._constants_cache is None:
+            self._constants_cache = np.ascontiguousarray(self.constants(), dtype=np.float64)
+        return self._constants_cache
+
+    # -- scene-specific, implemented by each task ------------------------------------------
+    # The three static methods below are compiled by numba (nopython): plain arithmetic on
+    # floats and 1-D float64 arrays, scene constants read from ``c`` (``self.constants()``).
+    NUM_OBSERVATIONS: ClassVar[int]
+
+    @staticmethod
+    def observe_one(q: Any, u: Any, brake: Any, time_left: float, c: Any, out: Any) -> None:
+        """Write one copy's observation into ``out`` (NUM_OBSERVATIONS,) float32."""
+        raise NotImplementedError
+
+    @staticmethod
+    def distance_one(q: Any, u: Any, c: Any) -> float:
+        """One copy's weighted distance from the goal at rest (0 at the goal)."""
+        raise NotImplementedError
+
+    @staticmethod
+    def success_one(q: Any, u: Any, c: Any) -> bool:
+        """Whether one copy is at the goal at rest within the task's tolerances."""
+        raise NotImplementedError
+
+    def constants(self) -> FloatArray:
+        """The scene constants ``c`` read by the compiled functions, float64 (any length)."""
+        raise NotImplementedError
+
+    def initial_state(self, rng: np.random.Generator) -> tuple[FloatArray, FloatArray]:
+        """One copy's start (q (n,), u (n,)), drawn from ``rng`` only."""
+        raise NotImplementedError
+
+    def decode_actions(self, actions: Any, state: BatchState) -> None:
+        """Validate a batch of actions and write ``state.tau`` [N m] and ``state.brake``."""
+        raise NotImplementedError
+
+    INFO_KEYS: ClassVar[tuple[str, ...]] = ()
+
+    @staticmethod
+    def info_one(q: Any, u: Any, brake: Any, impulses: Any, physics: Any, c: Any,
+                 out: Any) -> None:  # fmt: skip
+        """Write one copy's scene diagnostics (one value per ``INFO_KEYS`` entry) into ``out``.
+
+        impulses: the last physics step's impulses (c*d + k,); physics: its stepper
+        diagnostics (the ``mdi_envs.stepping`` INFO_* layout).
+        """
+
+    # -- shared ----------------------------------------------------------------------------
+    @property
+    def info_keys(self) -> tuple[str, ...]:
+        """Names of the ``info`` entries of a step, in the order of ``state.info`` columns."""
+        return self._info_keys
+
+    def advance(self, state: BatchState) -> None:
+        """Step the physics of every copy under ``state.tau`` and ``state.brake``, then the
+        rewards, observations and info columns (all written into ``state``).
+
+        Raises:
+            RuntimeError: the physics produced a non-finite state.
+        """
+        self.stepper.step_batch(state.q, state.u, state.tau, state.brake, self.frame_skip,
+                                check_inputs=False, out=(state.impulses, state.physics))
+        finite = _compiled(type(self))[0](
+            state.q, state.u, state.tau, state.brake, state.impulses, state.physics,
+            self._constants, self.dt, self.num_horizon_steps, self.effort_weight,
+            self.goal_weight, self.shaping_weight, self.shaping_discount, state.elapsed_steps,
+            state.effort, state.potential, state.terminated, state.reward, state.obs,
+            state.info,
+        )
+        if not finite:
+            raise RuntimeError(
+                "the physics step produced a non-finite state (solver status codes "
+                f"{state.physics[:, INFO_STATUS].tolist()}); please report this with the seed"
+            )
+
+    def info_arrays(self, state: BatchState) -> dict[str, Any]:
+        """The last step's info as name -> (N,) array (bool and int entries typed)."""
+        return {key: state.info[:, k].astype(_INFO_TYPES.get(key, np.float64))
+                for k, key in enumerate(self.info_keys)}  # fmt: skip
+
+    def info_dict(self, state: BatchState) -> dict[str, Any]:
+        """Copy 0's last-step info as name -> Python scalar."""
+        info = dict(zip(self._info_keys, state.info[0].tolist(), strict=True))
+        for key, kind in self._typed_keys:
+            info[key] = kind(info[key])
+        return info
+
+    def observe(self, state: BatchState) -> Any:
+        """Recompute every copy's observation into ``state.obs`` and return it."""
+        _compiled(type(self))[1](state.q, state.u, state.brake, state.elapsed_steps,
+                                 self.num_horizon_steps, self.dt, self._constants, state.obs)
+        return state.obs
+
+    def reset_copy(self, state: BatchState, index: int, rng: np.random.Generator) -> None:
+        """Put copy ``index`` at a fresh start state drawn from ``rng``."""
+        q, u = self.initial_state(rng)
+        state.q[index] = q
+        state.u[index] = u
+        state.tau[index] = 0.0
+        state.brake[index] = 0.0
+        state.elapsed_steps[index] = 0
+        state.effort[index] = 0.0
+        state.terminated[index] = False
+        self.update_potential(state, index)
+
+    def update_potential(self, state: BatchState, index: int) -> None:
+        """Phi of copy ``index`` after its state was set from outside the step."""
+        distance = _compiled(type(self))[2](state.q[index], state.u[index], self._constants)
+        state.potential[index] = -self.shaping_weight * distance
+
+    def noise(self, rng: np.random.Generator, size: int) -> FloatArray:
+        """Uniform start noise in [-reset_noise_scale, reset_noise_scale], (size,)."""
+        return rng.uniform(-self.reset_noise_scale, self.reset_noise_scale, size)
+
+
+class BatchState:
+    """The mutable state of N copies: physics arrays advanced in place, episode bookkeeping.
+
+    Attributes:
+        q, u: (N, n) coordinates and velocities. tau: (N, m) last torques [N m].
+        brake: (N, k) last brake bounds (0 released, inf ideal). elapsed_steps: (N,) env
+        steps. effort: (N,) integral of sum(tau^2) [N^2 m^2 s]. potential: (N,) Phi of the
+        current state. terminated: (N,) whether the last step ended the episode. reward (N,),
+        obs (N, NUM_OBSERVATIONS) float32, info (N, len(info_keys)): the last step's outputs.
+        impulses, physics: the stepper's outputs of the last physics step.
+    """
+
+    def __init__(self, task: MoreauJeanTask, num_copies: int) -> None:
+        model = task.MODEL
+        self.num_copies = num_copies
+        self.q = np.zeros((num_copies, model.NUM_DOFS))
+        self.u = np.zeros((num_copies, model.NUM_DOFS))
+        self.tau = np.zeros((num_copies, model.NUM_INPUTS))
+        self.brake = np.zeros((num_copies, model.NUM_BRAKES))
+        self.elapsed_steps = np.zeros(num_copies, np.int64)
+        self.effort = np.zeros(num_copies)
+        self.potential = np.zeros(num_copies)
+        self.terminated = np.zeros(num_copies, np.bool_)
+        self.reward = np.zeros(num_copies)
+        self.obs = np.zeros((num_copies, task.NUM_OBSERVATIONS), np.float32)
+        self.info = np.zeros((num_copies, len(task.info_keys)))
+        self.impulses = np.zeros((num_copies, task.stepper.num_impulses))
+        self.physics = np.zeros((num_copies, task.stepper.info_size))
+
+
+class MoreauJeanEnv(gym.Env[Any, Any]):
+    """A single Gymnasium environment running one copy of a ``MoreauJeanTask``.
+
+    Subclasses set ``TASK`` and ``metadata`` and implement ``_draw`` (rendering). Like
+    Gymnasium's MuJoCo base, it exposes ``dt``, ``set_state(q, u)`` and the model state.
+    """
+
+    TASK: ClassVar[type[MoreauJeanTask]]
+    metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
+
+    def __init__(self, render_mode: str | None = None, **options: Any) -> None:
+        _require(render_mode is None or render_mode in self.metadata["render_modes"],
+                 f"render_mode must be one of {self.metadata['render_modes']} or None, got "
+                 f"{render_mode!r}")  # fmt: skip
+        self.task = self.TASK(**options)
+        self.observation_space = self.task.single_observation_space
+        self.action_space = self.task.single_action_space
+        self.render_mode = render_mode
+        self.metadata = {**self.metadata, "render_fps": max(1, round(1.0 / self.task.dt))}
+        self.state = BatchState(self.task, 1)
+        self._viewer: Any = None
+        self._has_reset = False
+
+    @property
+    def dt(self) -> float:
+        """Duration of one env step [s] (time_step * frame_skip)."""
+        return self.task.dt
+
+    @property
+    def q(self) -> FloatArray:
+        """Coordinates (n,) (a copy)."""
+        return self.state.q[0].copy()
+
+    @property
+    def u(self) -> FloatArray:
+        """Velocities (n,) (a copy)."""
+        return self.state.u[0].copy()
+
+    def set_state(self, q: Any, u: Any) -> None:
+        """Overwrite the physical state; shapes (n,), finite values."""
+        n = self.task.MODEL.NUM_DOFS
+        for name, value in (("q", q), ("u", u)):
+            array = np.asarray(value, dtype=np.float64)
+            _require(array.shape == (n,), f"{name} must have shape ({n},), got {array.shape}")
+            _require(bool(np.isfinite(array).all()), f"{name} contains NaN or inf entries")
+        self.state.q[0] = q
+        self.state.u[0] = u
+        self.task.update_potential(self.state, 0)
+        self.task.observe(self.state)
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Advance by ``dt``; see the class docstring for rewards and ``info``."""
+        if not self._has_reset:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        self.task.decode_actions(action, self.state)
+        self.task.advance(self.state)
+        if self.render_mode == "human":
+            self.render()
+        return (self.state.obs[0].copy(), float(self.state.reward[0]),
+                bool(self.state.terminated[0]), False, self.task.info_dict(self.state))
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[Any, dict[str, Any]]:  # fmt: skip
+        """Start a new episode (start state drawn from ``self.np_random``)."""
+        super().reset(seed=seed)
+        self.task.reset_copy(self.state, 0, self.np_random)
+        self._has_reset = True
+        if self.render_mode == "human":
+            self.render()
+        return self.task.observe(self.state)[0].copy(), {}
+
+    def render(self) -> Any:
+        """Draw the scene: an (H, W, 3) uint8 array in "rgb_array" mode, a window in "human"."""
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode= to "
+                            "gym.make")  # fmt: skip
+            return None
+        from mdi_envs.rendering import Viewer
+
+        if self._viewer is None:
+            self._viewer = Viewer(self.render_mode, render_fps=self.metadata["render_fps"],
+                                  title=type(self).__name__)  # fmt: skip
+        return self._viewer.show(self._draw())
+
+    def _draw(self) -> Any:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Close the render window, if any."""
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
+
+
+class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
+    """``num_envs`` copies of a ``MoreauJeanTask`` stepped in one compiled call.
+
+    Autoreset: ``AutoresetMode.NEXT_STEP`` (Gymnasium's default): the step after an episode
+    ends resets that copy (its action is ignored, reward 0, terminated = truncated = False).
+    Each copy draws its start states from its own generator seeded ``seed + i``, as a
+    ``SyncVectorEnv`` seeds its sub-environments, so both give the same episodes.
+    """
+
+    TASK: ClassVar[type[MoreauJeanTask]]
+    metadata: dict[str, Any] = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
+                 render_mode: str | None = None, **options: Any) -> None:  # fmt: skip
+        _require(isinstance(num_envs, (int, np.integer)) and num_envs >= 1,
+                 f"num_envs must be a positive integer, got {num_envs!r}")
+        _require(render_mode is None, "the vector environments do not render; use gym.make "
+                 "for a rendered single environment")  # fmt: skip
+        self.task = self.TASK(**options)
+        self.num_envs = int(num_envs)
+        self.max_episode_steps = max_episode_steps
+        self.render_mode = None
+        self.single_observation_space = self.task.single_observation_space
+        self.single_action_space = self.task.single_action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.state = BatchState(self.task, self.num_envs)
+        self._rngs: list[np.random.Generator] = []
+        self._autoreset = np.zeros(self.num_envs, np.bool_)
+        self._step_mask = np.ones(self.num_envs, np.bool_)
+
+    @property
+    def dt(self) -> float:
+        """Duration of one env step [s]."""
+        return self.task.dt
+
+    def reset(self, *, seed: int | list[int | None] | None = None,
+              options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:  # fmt: skip
+        """Reset every copy; ``seed`` an int (copy i gets seed + i), a list, or None."""
+        if seed is None or isinstance(seed, (int, np.integer)):
+            seeds = [None if seed is None else int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+            _require(len(seeds) == self.num_envs,
+                     f"seed list has {len(seeds)} entries for {self.num_envs} envs")
+        self._rngs = [seeding.np_random(s)[0] for s in seeds]
+        if seed is not None:
+            self._np_random, self._np_random_seed = seeding.np_random(seeds[0])
+        for i, rng in enumerate(self._rngs):
+            self.task.reset_copy(self.state, i, rng)
+        self._autoreset[:] = False
+        return self.task.observe(self.state).copy(), {}
+
+    def step(self, actions: Any) -> tuple[Any, FloatArray, BoolArray, BoolArray, dict[str, Any]]:
+        """Advance every copy by ``dt`` (copies that ended last step are reset instead)."""
+        if not self._rngs:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        self.task.decode_actions(actions, self.state)
+        self.task.advance(self.state)
+        reward = self.state.reward
+        info = self.task.info_arrays(self.state)
+        terminated = self.state.terminated.copy()
+        if self.max_episode_steps is not None:
+            truncated = self.state.elapsed_steps >= self.max_episode_steps
+        else:
+            truncated = np.zeros(self.num_envs, np.bool_)
+        reward = reward.copy()
+        resetting = np.flatnonzero(self._autoreset)
+        for i in resetting:
+            self.task.reset_copy(self.state, int(i), self._rngs[i])
+        if resetting.size:
+            self.task.observe(self.state)
+            reward[resetting] = 0.0
+            terminated[resetting] = False
+            truncated[resetting] = False
+        self._autoreset = terminated | truncated
+        mask = self._step_mask
+        mask[:] = True
+        mask[resetting] = False
+        infos: dict[str, Any] = {}
+        for key, value in info.items():
+            infos[key] = value
+            infos["_" + key] = mask.copy()
+        return self.state.obs.copy(), reward, terminated, truncated, infos
+
+
+_COMPILED: dict[type[MoreauJeanTask], tuple[Any, Any, Any]] = {}
+
+
+def _compiled(task: type[MoreauJeanTask]) -> tuple[Any, Any, Any]:
+    """The batched kernels of ``task`` (compiled once per task class and process).
+
+    Returns (evaluate, observe_all, distance_one); see ``MoreauJeanTask.advance``.
+    """
+    if task in _COMPILED:
+        return _COMPILED[task]
+    observe_one = njit(task.observe_one)
+    distance_one = njit(task.distance_one)
+    success_one = njit(task.success_one)
+    info_one = njit(task.info_one)
+
+    @njit
+    def evaluate(q, u, tau, brake, impulses, physics, c, dt, horizon, effort_weight,  # noqa: ANN001
+                 goal_weight, shaping_weight, discount, elapsed, effort, potential, terminated,
+                 reward, obs, info):
+        finite = True
+        for i in range(q.shape[0]):
+            for j in range(q.shape[1]):
+                if not (np.isfinite(q[i, j]) and np.isfinite(u[i, j])):
+                    finite = False
+            elapsed[i] += 1
+            rate = 0.0
+            for j in range(tau.shape[1]):
+                rate += tau[i, j] * tau[i, j]
+            effort[i] += rate * dt
+            d = distance_one(q[i], u[i], c)
+            s = success_one(q[i], u[i], c)
+            if horizon == 0:  # objective "time": success ends the episode
+                objective = -dt
+                ended = s
+                goal = 0.0
+            else:  # objective "effort" over a fixed horizon
+                objective = -effort_weight * rate * dt
+                ended = elapsed[i] >= horizon
+                goal = -goal_weight * d if ended else 0.0
+            phi = 0.0 if ended else -shaping_weight * d
+            shaping = discount * phi - potential[i]
+            potential[i] = phi
+            reward[i] = objective + shaping + goal
+            terminated[i] = ended
+            row = info[i]  # BASE_INFO_KEYS, then the scene's INFO_KEYS
+            row[0] = objective
+            row[1] = shaping
+            row[2] = goal
+            row[3] = d
+            row[4] = 1.0 if s else 0.0
+            row[5] = elapsed[i] * dt
+            row[6] = effort[i]
+            row[7] = physics[i, INFO_STATUS]
+            row[8] = physics[i, INFO_ITERATIONS]
+            row[9] = physics[i, INFO_ACTIVE_CONTACTS]
+            info_one(q[i], u[i], brake[i], impulses[i], physics[i], c, row[10:])
+            time_left = (horizon - elapsed[i]) * dt if horizon > 0 else 0.0
+            observe_one(q[i], u[i], brake[i], time_left, c, obs[i])
+        return finite
+
+    @njit
+    def observe_all(q, u, brake, elapsed, horizon, dt, c, obs):  # noqa: ANN001
+        for i in range(q.shape[0]):
+            time_left = (horizon - elapsed[i]) * dt if horizon > 0 else 0.0
+            observe_one(q[i], u[i], brake[i], time_left, c, obs[i])
+
+    _COMPILED[task] = (evaluate, observe_all, distance_one)
+    return _COMPILED[task]
+
+
+__all__ = ["BatchState", "MoreauJeanEnv", "MoreauJeanTask", "MoreauJeanVectorEnv"]
