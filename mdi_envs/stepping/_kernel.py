@@ -160,7 +160,7 @@ def make_free_motion(
     reuse_mass = (shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
                   and not velocity_forces)
 
-    @njit
+    @njit(inline="always")
     def free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col,  # noqa: ANN001
                     mass_ready):
         for i in range(n):
@@ -218,7 +218,7 @@ def make_step_kernels(
     carve_floats = _make_carver(float_layout)
     carve_ints = _make_carver(int_layout)
 
-    @njit
+    @njit(inline="always")
     def advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fs, js):  # noqa: ANN001
         """Advance one step of length dt [s].
 
