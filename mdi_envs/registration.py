@@ -8,6 +8,8 @@ _ENVS = {
     # id: (module, class prefix, max_episode_steps)
     "mdi_envs/BlockableManipulator-v0": ("blockable_manipulator", "BlockableManipulator", 500),
     "mdi_envs/DiffDriveRobot-v0": ("diff_drive", "DiffDriveRobot", 200),
+    "mdi_envs/BouncingBall-v0": ("bouncing_ball", "BouncingBall", 600),
+    "mdi_envs/SlidingBlock-v0": ("sliding_block", "SlidingBlock", 500),
 }
 ENV_IDS = tuple(_ENVS)
 

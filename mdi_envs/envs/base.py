@@ -22,6 +22,7 @@ and small arrays, compiled with numba into one batched kernel per task class, so
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any, ClassVar
 
@@ -52,6 +53,7 @@ N^2 m^2 s; solver_status a ``SolverStatus`` code, 0 = converged, the worst over 
 _INFO_TYPES: dict[str, Any] = {
     "is_success": bool, "brake_engaged": bool, "solver_status": int, "solver_iterations": int,
     "num_active_contacts": int, "slip_mode": int, "num_lifted_contacts": int,
+    "is_sticking": bool,
 }
 
 
@@ -65,6 +67,18 @@ def _positive(name: str, value: Any) -> float:
              and math.isfinite(value) and value > 0, f"{name} must be a finite number > 0, "
              f"got {value!r}")  # fmt: skip
     return float(value)
+
+
+def build_parameters(parameters: Any, defaults: type[Any], **overrides: Any) -> Any:
+    """``parameters`` (default ``defaults()``) with the non-None ``overrides`` replaced.
+
+    The dataclass validates the result: a bad value raises ValueError naming its field.
+    """
+    base = defaults() if parameters is None else parameters
+    if not isinstance(base, defaults):
+        raise ValueError(f"parameters must be a {defaults.__name__}, got {type(base).__name__}")
+    changes = {name: value for name, value in overrides.items() if value is not None}
+    return dataclasses.replace(base, **changes) if changes else base
 
 
 def _nonnegative(name: str, value: Any) -> float:

@@ -17,27 +17,17 @@ import numpy as np
 import pytest
 
 import mdi_envs  # noqa: F401  (registers the ids)
-from mdi_envs.envs.bouncing_ball import BouncingBallEnv
-from mdi_envs.envs.sliding_block import SlidingBlockEnv
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
 from mdi_envs.mechanics.models.sliding_block import SlidingBlockParameters
 
 BALL_ID = "mdi_envs/BouncingBall-v0"
 BLOCK_ID = "mdi_envs/SlidingBlock-v0"
-_FALLBACK: dict[str, tuple[type[gym.Env[Any, Any]], int]] = {
-    BALL_ID: (BouncingBallEnv, 600),
-    BLOCK_ID: (SlidingBlockEnv, 500),
-}
 
 
 def make(env_id: str, **kwargs: Any) -> gym.Env[Any, Any]:
-    """``gym.make(env_id)``; the class under its time limit if the id is not registered."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        if env_id in gym.registry:
-            return gym.make(env_id, **kwargs)
-        env_class, max_episode_steps = _FALLBACK[env_id]
-        return gym.wrappers.TimeLimit(env_class(**kwargs), max_episode_steps)
+        return gym.make(env_id, **kwargs)
 
 
 ZERO = np.zeros(1, np.float32)
