@@ -58,6 +58,10 @@ def _build_parser() -> argparse.ArgumentParser:
     solve.add_argument("path", type=Path, help="the .dat file")
     solve.add_argument("--method", default="lemke", help="LCP method (default: lemke)")
     solve.set_defaults(handler=_run_solve)
+
+    from optimal.cli import add_optimize_parser
+
+    add_optimize_parser(commands)
     return parser
 
 

@@ -1,0 +1,59 @@
+"""``mdi-envs optimize NAME``: recompute one reference with progress output.
+
+Wiring (in ``mdi_envs/cli.py``): ``from optimal.cli import add_optimize_parser`` and call
+``add_optimize_parser(commands)`` on the subparsers; the parser's handler is ``run_optimize``.
+Example: ``mdi-envs optimize manipulator_time --output results/optimal`` (about a minute)
+prints one line per continuation stage and per replay, writes ``NAME.npz``/``NAME.json`` and
+the PNG figures into ``--output`` and, with ``--install``, into the package's references.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+
+def add_optimize_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``optimize`` subcommand to an argparse subparsers object; returns its parser."""
+    from optimal.problems import PROBLEMS
+
+    parser = subparsers.add_parser(
+        "optimize",
+        help="compute an optimal-control reference (penalty/continuation, CasADi + IPOPT)",
+        description="Solve one named problem from its naive guess by the combined penalty/"
+        "continuation method, replay its controls in the simulator at h and h/10, and save "
+        "arrays, metadata and figures. Needs CasADi (pip install 'mdi-envs[optimal]').",
+    )
+    parser.add_argument("name", choices=sorted(PROBLEMS), help="the problem")
+    parser.add_argument("--output", type=Path, default=Path("results/optimal"),
+                        help="folder for NAME.npz, NAME.json and the PNGs")
+    parser.add_argument("--intervals", type=int, default=None, help="N (default: the problem's)")
+    parser.add_argument("--install", action="store_true",
+                        help="also write the reference into optimal/references (package data)")
+    parser.set_defaults(handler=run_optimize)
+    return parser
+
+
+def run_optimize(args: argparse.Namespace) -> int:
+    """Handler of ``optimize``: returns 0 when the reference converged and reaches the goal."""
+    from optimal.plots import plot_reference
+    from optimal.references import REFERENCE_DIR, save_reference
+    from optimal.solve import solve_problem
+
+    reference = solve_problem(args.name, args.intervals, progress=lambda line: print(line,
+                                                                                     flush=True))
+    meta = reference.metadata
+    path = save_reference(reference, args.output)
+    print(f"{args.name}: t_f = {meta['final_time']:.4f} s, cost = {meta['cost']:.6g}, "
+          f"solve time {meta['solve_time']:.1f} s, converged: {meta['converged']}")
+    print(f"saved {path} and {path.with_suffix('.npz')}")
+    for png in plot_reference(reference, args.output):
+        print(f"saved {png}")
+    if args.install:
+        print(f"installed {save_reference(reference, REFERENCE_DIR)}")
+    ok = meta["converged"] and meta["replay"][0]["reaches_goal"]
+    return 0 if ok else 1
+
+
+__all__ = ["add_optimize_parser", "run_optimize"]

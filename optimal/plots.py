@@ -1,0 +1,123 @@
+"""Pictures of a reference like the paper's: Figs. 3-4 (manipulator) and 7-9 (robot).
+
+``plot_reference(reference, directory)`` writes PNGs and returns their paths. Needs matplotlib
+(``pip install 'mdi-envs[render]'``), imported here only, with the non-interactive Agg backend.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from optimal.references import Reference
+
+
+def plot_reference(reference: Reference, directory: Path | str) -> list[Path]:
+    """Save the reference's figures into ``directory``; returns the PNG paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    folder = Path(directory)
+    folder.mkdir(parents=True, exist_ok=True)
+    if reference.brake_bound is not None:
+        return _manipulator(reference, folder)
+    if "mode" in reference.arrays:
+        return _robot(reference, folder)
+    return []
+
+
+def _manipulator(reference: Reference, folder: Path) -> list[Path]:
+    """Fig. 3 (velocities, positions) and Fig. 4 (torque, brake impulses)."""
+    import matplotlib.pyplot as plt
+
+    t, q, u = reference.time, reference.q, reference.u
+    engaged = np.isinf(reference.brake_bound[:, 0])
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    axes[0].plot(t, u[:, 0], label="alpha'")
+    axes[0].plot(t, u[:, 1], label="beta'")
+    axes[0].plot(t, u[:, 1] - u[:, 0], "--", label="beta' - alpha'")
+    axes[0].set_ylabel("velocity [rad/s]")
+    axes[1].plot(t, q[:, 0], label="alpha")
+    axes[1].plot(t, q[:, 1], label="beta")
+    axes[1].set_ylabel("position [rad]")
+    axes[1].set_xlabel("time [s]")
+    for ax in axes:
+        ax.fill_between(t[:-1], 0, 1, where=engaged, step="post", alpha=0.12, color="k",
+                        transform=ax.get_xaxis_transform(), label="brake engaged")
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"{reference.name}: t_f = {reference.final_time:.3f} s (cf. paper Fig. 3)")
+    first = folder / f"{reference.name}_states.png"
+    fig.savefig(first, dpi=110)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    axes[0].step(t[:-1], reference.tau[:, 0], where="post")
+    axes[0].set_ylabel("motor torque [N m]")
+    impulses = reference.arrays["brake_impulse"][:, 0]
+    axes[1].stem(t[1:], impulses, basefmt=" ")
+    axes[1].set_ylabel("brake impulse P_B [N m s]")
+    axes[1].set_xlabel("time [s]")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"{reference.name}: controls (cf. paper Fig. 4)")
+    second = folder / f"{reference.name}_controls.png"
+    fig.savefig(second, dpi=110)
+    plt.close(fig)
+    return [first, second]
+
+
+def _robot(reference: Reference, folder: Path) -> list[Path]:
+    """Figs. 7/8 (path coloured by mode) and Fig. 9 (contact forces, slip speeds)."""
+    import matplotlib.pyplot as plt
+
+    t, q, h = reference.time, reference.q, reference.time_step
+    modes = reference.arrays["mode"]
+    fig, ax = plt.subplots(figsize=(5, 6))
+    colours = {2: "tab:green", 3: "tab:orange", 5: "tab:red"}
+    for mode, colour in colours.items():
+        chosen = np.flatnonzero(modes == mode)
+        if chosen.size:
+            ax.scatter(q[chosen + 1, 0], q[chosen + 1, 1], s=8, color=colour,
+                       label=f"{mode}-DOF mode")
+    ax.plot(q[:, 0], q[:, 1], color="0.6", lw=0.8, zorder=0)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_aspect("equal")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    ax.set_title(f"{reference.name}: t_f = {reference.final_time:.2f} s (cf. Figs. 7-8)")
+    first = folder / f"{reference.name}_path.png"
+    fig.savefig(first, dpi=110)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex=True)
+    normal = reference.arrays["normal_impulse"] / h
+    tangent = reference.arrays["tangent_impulse"] / h
+    slip = reference.arrays["slip_speed"]
+    for i, label in enumerate(("N_L", "N_R", "N_stick")):
+        axes[0, 0].plot(t[1:], normal[:, i], label=label)
+    axes[0, 0].set_ylabel("normal force [N]")
+    for i, label in enumerate(("v_L", "v_R", "v_stick")):
+        axes[0, 1].plot(t[1:], slip[:, i], label=label)
+    axes[0, 1].set_ylabel("slip speed [m/s]")
+    axes[1, 0].plot(t[1:], tangent[:, 0], label="F_Lx")
+    axes[1, 0].plot(t[1:], tangent[:, 1], label="F_Ly")
+    axes[1, 0].set_ylabel("left wheel friction [N]")
+    axes[1, 1].plot(t[1:], tangent[:, 2], label="F_Rx")
+    axes[1, 1].plot(t[1:], tangent[:, 3], label="F_Ry")
+    axes[1, 1].set_ylabel("right wheel friction [N]")
+    for ax in axes.ravel():
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+    for ax in axes[1]:
+        ax.set_xlabel("time [s]")
+    fig.suptitle(f"{reference.name}: contact forces and slip (cf. paper Fig. 9)")
+    second = folder / f"{reference.name}_contacts.png"
+    fig.savefig(second, dpi=110)
+    plt.close(fig)
+    return [first, second]
+
+
+__all__ = ["plot_reference"]

@@ -1,0 +1,66 @@
+"""Every shipped reference: loads without CasADi, carries its metadata, replays to the goal."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from optimal import available_references, load_reference
+from optimal.replay import replay, replay_in_env
+
+SHIPPED = available_references()
+METADATA_FIELDS = ("env_id", "env_version", "time_step", "num_intervals", "cost", "final_time",
+                   "history", "replay", "commit", "solve_time", "converged")
+
+
+def test_load_reference_names_the_available_ones() -> None:
+    with pytest.raises(FileNotFoundError, match="available"):
+        load_reference("no_such_reference")
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_reference_loads_without_casadi(name: str) -> None:
+    code = (
+        "import sys; sys.modules['casadi'] = None\n"
+        "from optimal import load_reference\n"
+        f"r = load_reference({name!r})\n"
+        "assert r.q.shape[0] == r.tau.shape[0] + 1\n"
+        "print(r.final_time)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    assert float(done.stdout) == pytest.approx(load_reference(name).final_time)
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_reference_metadata_and_final_stage(name: str) -> None:
+    reference = load_reference(name)
+    for key in METADATA_FIELDS:
+        assert key in reference.metadata
+    assert reference.metadata["converged"]
+    last = reference.metadata["history"][-1]
+    assert last["residual"] <= 1e-8
+    assert reference.time_step == pytest.approx(reference.final_time / reference.tau.shape[0])
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_reference_replays_to_the_goal(name: str) -> None:
+    reference = load_reference(name)
+    report, q, _, _ = replay(reference, substeps=1)
+    assert report.reaches_goal, report.goal_errors
+    assert report.state_error <= 1e-6
+    np.testing.assert_allclose(q[-1], reference.q[-1], atol=1e-6)
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_reference_replays_to_the_goal_in_the_gym_env(name: str) -> None:
+    """Open loop through gym.make(env_id): the env's own success test passes at the end."""
+    reference = load_reference(name)
+    q, info = replay_in_env(reference)
+    assert info["is_success"], info
+    assert info["elapsed_time"] == pytest.approx(reference.final_time, rel=1e-9)
+    np.testing.assert_allclose(q, reference.q[-1], atol=1e-6)
