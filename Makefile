@@ -27,6 +27,7 @@ test: $(VENV)/.installed-test
 bench: $(VENV)/.installed-bench
 	$(BIN)/python -m benchmarks.solvers --output results/bench
 	$(BIN)/python -m benchmarks.engine --output results/bench
+	$(BIN)/python -m benchmarks.envs --output results/bench
 
 lint: $(VENV)/.installed-dev
 	$(BIN)/ruff check mdi_envs tests benchmarks

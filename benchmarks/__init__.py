@@ -1,6 +1,7 @@
-"""Benchmarks of the LCP solvers and of the time-stepping engine (vs MuJoCo).
+"""Benchmarks of the LCP solvers, the time-stepping engine (vs MuJoCo) and the environments.
 
-Run ``python -m benchmarks.solvers`` and ``python -m benchmarks.engine``.
+Run ``python -m benchmarks.solvers``, ``python -m benchmarks.engine`` and
+``python -m benchmarks.envs``.
 
 Modules:
     problems: the seeded random LCP families and the Siconos peer problems.
@@ -15,4 +16,6 @@ Modules:
     engine_mujoco: the MuJoCo peer of the blockable manipulator (MJCF, steps, rollouts).
     engine_report: the engine benchmark's Markdown tables and plots.
     engine: the command line of the engine benchmark.
+    envs: env.step through gym.make and vector-env throughput vs Acrobot-v1 and MuJoCo's
+        InvertedDoublePendulum-v5 (its report: envs_report).
 """

@@ -1,0 +1,521 @@
+"""Environment benchmark: ``env.step`` µs through ``gym.make`` and vector-env throughput.
+
+Usage (from the repository root)::
+
+    python -m benchmarks.envs --output results/bench
+    python -m benchmarks.envs --output /tmp/bench --quick   # N <= 256, small budgets
+
+Writes ``envs.json``, ``envs_step.png`` and ``envs_vector.png`` to the output folder, prints
+progress lines on stderr and the Markdown results tables (the ones in ``benchmarks/README.md``)
+on stdout. Parts:
+
+1. first call: ``gym.make`` + ``reset`` + the first ``step`` of every environment, timed once
+   (for ours it holds the numba JIT compile) and excluded from everything else;
+2. single env: ``env.step`` of every registered ``mdi_envs.ENV_IDS`` and of the peers
+   (Gymnasium's ``Acrobot-v1``, MuJoCo's ``InvertedDoublePendulum-v5``) through ``gym.make``
+   (default wrappers) and unwrapped, interleaved, with pre-sampled actions and a reset whenever
+   an episode ends;
+3. vector env: env-steps/s of ``gym.make_vec(id, num_envs=N,
+   vectorization_mode="vector_entry_point")`` for each N, interleaved per N with Acrobot-v1 in
+   Gymnasium's ``"sync"`` mode (N <= 256), and physics steps/s = env-steps/s x frame_skip.
+
+The process is pinned to one CPU (``--cpu``, default 0) for the run; numba threading is not
+used (no kernel of ``mdi_envs`` is parallel).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+
+import mdi_envs
+from benchmarks import envs_report as R
+from benchmarks import report
+from benchmarks.timing import Progress, TimingPlan, load_average, machine_info, time_interleaved
+
+ACROBOT = "Acrobot-v1"
+MUJOCO_PEER = "InvertedDoublePendulum-v5"
+MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
+
+VERSIONED = ("numpy", "numba", "llvmlite", "gymnasium", "mujoco", "mdi-envs")
+"""Distributions whose versions the JSON records."""
+
+TARGETS = {
+    "manipulator_step_us": 10.0,
+    "speedup_vs_acrobot": 3.0,
+    "manipulator_physics_steps_per_s": 5e6,
+    "manipulator_vector_copies": 4096,
+}
+"""The brief's targets: manipulator ``env.step`` <= 10 µs, >= 3x faster than Acrobot-v1,
+>= 5e6 physics steps/s of the manipulator vector env at num_envs = 4096 on one core."""
+
+UNITS = {
+    "*_s": "seconds",
+    "*_us": "microseconds",
+    "*_per_s": "per second (wall clock)",
+    "ratio_*": "dimensionless (peer time / our time; > 1: ours faster)",
+    "frame_skip": "physics steps per env step",
+    "num_envs": "copies in one vector env",
+    "rounds, number": "timed samples, calls per sample",
+}
+
+
+@dataclass(frozen=True)
+class EnvsConfig:
+    """Environments, grid and timing budgets of one run.
+
+    Attributes:
+        env_ids: our environments (None: every registered ``mdi_envs.ENV_IDS``).
+        peers: comparison environments timed like ours with ``gym.make`` (one that cannot be
+            made is recorded with the reason and skipped).
+        sync_peer: the environment timed in Gymnasium's ``"sync"`` vector mode (None: none).
+        sync_max_copies: largest N of the sync peer.
+        copies: the N of the vector study.
+        action_samples: pre-sampled actions (single) or action batches (vector), cycled.
+        step_plan: timing plan of the single-env study (all entries interleaved at once).
+        vector_plan: timing plan per N of the vector study.
+        cpu: CPU to pin the process to during the run (None: no pinning).
+        seed: seed of the resets and of the action spaces.
+    """
+
+    env_ids: tuple[str, ...] | None
+    peers: tuple[str, ...]
+    sync_peer: str | None
+    sync_max_copies: int
+    copies: tuple[int, ...]
+    action_samples: int
+    step_plan: TimingPlan
+    vector_plan: TimingPlan
+    cpu: int | None = 0
+    seed: int = 0
+
+
+FULL = EnvsConfig(
+    env_ids=None,
+    peers=(ACROBOT, MUJOCO_PEER),
+    sync_peer=ACROBOT,
+    sync_max_copies=256,
+    copies=(1, 4, 16, 64, 256, 1024, 4096),
+    action_samples=1024,
+    step_plan=TimingPlan(budget_s=2.0, min_rounds=21, max_rounds=301, min_batch_s=5e-3),
+    vector_plan=TimingPlan(budget_s=0.6, min_rounds=9, max_rounds=61, min_batch_s=5e-3),
+)
+QUICK = EnvsConfig(
+    env_ids=None,
+    peers=(ACROBOT, MUJOCO_PEER),
+    sync_peer=ACROBOT,
+    sync_max_copies=256,
+    copies=(1, 4, 16, 64, 256),
+    action_samples=256,
+    step_plan=TimingPlan(budget_s=0.2, min_rounds=9, max_rounds=51, min_batch_s=2e-3),
+    vector_plan=TimingPlan(budget_s=0.1, min_rounds=5, max_rounds=15, min_batch_s=2e-3),
+)
+
+
+def frame_skip(env: Any) -> int:
+    """Physics steps per env step: ``task.frame_skip`` for ours, ``frame_skip`` (MuJoCo) else 1.
+
+    Works on a single env, a vector env and a ``SyncVectorEnv`` (its first sub-env).
+    """
+    if hasattr(env, "envs"):
+        env = env.envs[0]
+    inner = env.unwrapped
+    task = getattr(inner, "task", None)
+    if task is not None and hasattr(task, "frame_skip"):
+        return int(task.frame_skip)
+    return int(getattr(inner, "frame_skip", 1))
+
+
+def _wrapper_chain(env: Any) -> list[str]:
+    """Class names from the outermost wrapper down to the env."""
+    names = []
+    while True:
+        names.append(type(env).__name__)
+        if not isinstance(env, gym.Wrapper):
+            return names
+        env = env.env
+
+
+def _sample_actions(space: gym.Space, count: int, seed: int) -> list[Any]:
+    """``count`` actions sampled before any timing (the timed loop only indexes them)."""
+    space.seed(seed)
+    return [space.sample() for _ in range(count)]
+
+
+class StepLoop:
+    """One ``env.step`` per call with the next pre-sampled action; reset when an episode ends.
+
+    Args:
+        env: a reset single environment (wrapped or unwrapped).
+        actions: the pre-sampled actions, cycled.
+        max_steps: truncate after this many steps (for an unwrapped env without TimeLimit;
+            None: rely on the env's own ``truncated``).
+
+    Attributes:
+        steps, episodes: steps taken and episodes ended so far.
+    """
+
+    def __init__(self, env: Any, actions: list[Any], max_steps: int | None = None) -> None:
+        self.env = env
+        self.actions = actions
+        self.max_steps = max_steps
+        self.index = 0
+        self.episode_steps = 0
+        self.steps = 0
+        self.episodes = 0
+
+    def __call__(self) -> None:
+        """Step once (and reset if the episode ended)."""
+        index = self.index
+        _, _, terminated, truncated, _ = self.env.step(self.actions[index])
+        index += 1
+        self.index = 0 if index == len(self.actions) else index
+        self.steps += 1
+        self.episode_steps += 1
+        if terminated or truncated or self.episode_steps == self.max_steps:
+            self.env.reset()
+            self.episodes += 1
+            self.episode_steps = 0
+
+
+class VectorLoop:
+    """One vector ``step`` per call with the next pre-sampled action batch (autoreset inside)."""
+
+    def __init__(self, env: Any, actions: list[Any]) -> None:
+        self.env = env
+        self.actions = actions
+        self.index = 0
+
+    def __call__(self) -> None:
+        """Step every copy once."""
+        self.env.step(self.actions[self.index])
+        self.index = (self.index + 1) % len(self.actions)
+
+
+def _error_text(error: BaseException) -> str:
+    return f"{type(error).__name__}: {error}"
+
+
+def _make_single(env_id: str, ours: bool, seed: int, samples: int
+                 ) -> tuple[dict[str, Any], list[Any]]:
+    """Make the env twice (timed ``gym.make`` and unwrapped) and time the first calls.
+
+    Returns:
+        (the environment's record, [gym.make loop, unwrapped loop]).
+    """
+    start = time.perf_counter()
+    env = gym.make(env_id)
+    make_s = time.perf_counter() - start
+    env.reset(seed=seed)
+    reset_s = time.perf_counter() - start - make_s
+    actions = _sample_actions(env.action_space, samples, seed)
+    start = time.perf_counter()
+    env.step(actions[0])
+    first_step_s = time.perf_counter() - start
+    env.reset(seed=seed)
+    bare = gym.make(env_id).unwrapped
+    bare.reset(seed=seed)
+    bare.step(actions[0])
+    bare.reset(seed=seed)
+    spec = env.spec
+    max_steps = spec.max_episode_steps if spec is not None else None
+    record = {
+        "env_id": env_id,
+        "ours": ours,
+        "wrappers": _wrapper_chain(env),
+        "frame_skip": frame_skip(env),
+        "dt_s": float(env.unwrapped.dt) if hasattr(env.unwrapped, "dt") else None,
+        "max_episode_steps": max_steps,
+        "action_space": str(env.action_space),
+        "first_make_s": make_s,
+        "first_reset_s": reset_s,
+        "first_step_s": first_step_s,
+    }
+    return record, [StepLoop(env, actions), StepLoop(bare, actions, max_steps)]
+
+
+def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsConfig,
+                     log: Callable[[str], None]
+                     ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """``env.step`` through ``gym.make`` and unwrapped, for ours and the peers, interleaved.
+
+    Returns:
+        (one record per env that was made, one record per env that could not be made).
+    """
+    records, unavailable, calls = [], [], {}
+    loops: dict[str, StepLoop] = {}
+    for env_id in (*env_ids, *peers):
+        log(f"making {env_id} (first make/reset/step; numba compiles ours) ...")
+        try:
+            record, (wrapped, bare) = _make_single(env_id, env_id in env_ids, config.seed,
+                                                   config.action_samples)
+        except Exception as error:  # noqa: BLE001  (any failure of a peer is recorded)
+            unavailable.append({"env_id": env_id, "error": _error_text(error)})
+            log(f"  {env_id} not measured: {unavailable[-1]['error']}")
+            continue
+        records.append(record)
+        loops[f"{env_id}|gym.make"] = wrapped
+        loops[f"{env_id}|unwrapped"] = bare
+        log(f"  first step {record['first_step_s']:.2f} s, make {record['first_make_s']:.2f} s,"
+            f" frame_skip {record['frame_skip']}")
+    calls.update(loops)
+    log(f"single env: {len(calls)} step loops, interleaved; load {_load_text()} ...")
+    timed = time_interleaved(calls, config.step_plan)
+    for record in records:
+        for entry in ("gym.make", "unwrapped"):
+            key = f"{record['env_id']}|{entry}"
+            summary = timed[key].summary()
+            loop = loops[key]
+            record[entry] = {
+                "median_us": summary["median_s"] * 1e6,
+                "q1_us": summary["q1_s"] * 1e6,
+                "q3_us": summary["q3_s"] * 1e6,
+                "min_us": summary["min_s"] * 1e6,
+                "rounds": summary["rounds"],
+                "number": summary["number"],
+                "steps_total": loop.steps,
+                "episodes_ended": loop.episodes,
+            }
+        record["per_physics_step_us"] = record["gym.make"]["median_us"] / record["frame_skip"]
+        loops[f"{record['env_id']}|gym.make"].env.close()
+        loops[f"{record['env_id']}|unwrapped"].env.close()
+    _add_ratios(records)
+    for r in records:
+        log(f"  {r['env_id']}: env.step {r['gym.make']['median_us']:.1f} µs (gym.make), "
+            f"{r['unwrapped']['median_us']:.1f} µs (unwrapped)")
+    return records, unavailable
+
+
+def _add_ratios(records: list[dict[str, Any]]) -> None:
+    """Peer time / our time for each of ours and each peer (medians and fastest rounds)."""
+    peers = [r for r in records if not r["ours"]]
+    for record in records:
+        if not record["ours"]:
+            continue
+        record["ratios"] = {
+            peer["env_id"]: {
+                "ratio_median": peer["gym.make"]["median_us"] / record["gym.make"]["median_us"],
+                "ratio_fastest": peer["gym.make"]["min_us"] / record["gym.make"]["min_us"],
+                "ratio_median_unwrapped": (peer["unwrapped"]["median_us"]
+                                           / record["unwrapped"]["median_us"]),
+            }
+            for peer in peers
+        }
+
+
+def _vector_entry(env_id: str, mode: str, num_envs: int, config: EnvsConfig
+                  ) -> tuple[VectorLoop, dict[str, Any]]:
+    """A reset vector env with pre-sampled action batches, and its description."""
+    start = time.perf_counter()
+    env = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode=mode)
+    env.reset(seed=config.seed)
+    samples = max(2, min(config.action_samples, 16))
+    actions = _sample_actions(env.action_space, samples, config.seed)
+    loop = VectorLoop(env, actions)
+    loop()
+    setup_s = time.perf_counter() - start
+    return loop, {"env_id": env_id, "mode": mode, "num_envs": num_envs,
+                  "frame_skip": frame_skip(env), "setup_s": setup_s,
+                  "action_batches": samples}
+
+
+def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str], None]
+                 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Env-steps/s and physics steps/s of each vector env per N, interleaved per N.
+
+    Returns:
+        (one record per (env, mode, N), one record per env/mode that could not be made).
+    """
+    rows: list[dict[str, Any]] = []
+    unavailable: list[dict[str, Any]] = []
+    failed: set[str] = set()
+    entries = [(env_id, "vector_entry_point") for env_id in env_ids]
+    if config.sync_peer is not None:
+        entries.append((config.sync_peer, "sync"))
+    for n in config.copies:
+        loops: dict[str, VectorLoop] = {}
+        meta: dict[str, dict[str, Any]] = {}
+        for env_id, mode in entries:
+            key = f"{env_id}|{mode}"
+            if key in failed or (mode == "sync" and n > config.sync_max_copies):
+                continue
+            try:
+                loops[key], meta[key] = _vector_entry(env_id, mode, n, config)
+            except Exception as error:  # noqa: BLE001  (recorded, the run continues)
+                failed.add(key)
+                unavailable.append({"env_id": env_id, "mode": mode, "num_envs": n,
+                                    "error": _error_text(error)})
+                log(f"  {key} N = {n} not measured: {unavailable[-1]['error']}")
+        if not loops:
+            continue
+        timed = time_interleaved(loops, config.vector_plan)
+        measured = []
+        for key, value in timed.items():
+            summary = value.summary()
+            info = meta[key]
+            skip = info["frame_skip"]
+            row = {
+                **info,
+                "call": summary,
+                "env_steps_per_s": n / summary["median_s"],
+                "env_steps_per_s_q1": n / summary["q3_s"],
+                "env_steps_per_s_q3": n / summary["q1_s"],
+                "env_steps_per_s_best": n / summary["min_s"],
+                "per_env_step_us": summary["median_s"] / n * 1e6,
+            }
+            for name in ("", "_q1", "_q3", "_best"):
+                row[f"physics_steps_per_s{name}"] = row[f"env_steps_per_s{name}"] * skip
+            measured.append(row)
+            loops[key].env.close()
+        rows += measured
+        log(f"vector N = {n}: " + ", ".join(
+            f"{R.short_name(r['env_id'])} ({r['mode']}) {r['env_steps_per_s']:.3g} env-steps/s"
+            for r in measured) + f"; load {_load_text()}")
+    return rows, unavailable
+
+
+def evaluate_targets(single: Sequence[dict[str, Any]], vector: Sequence[dict[str, Any]]
+                     ) -> list[dict[str, Any]]:
+    """The brief's targets against the measurements (``met`` None where not measured)."""
+    by_id = {r["env_id"]: r for r in single}
+    manipulator = by_id.get(MANIPULATOR)
+    step = manipulator["gym.make"]["median_us"] if manipulator else None
+    targets = [R.target_row("manipulator env.step through gym.make (median)", "≤",
+                            TARGETS["manipulator_step_us"], "µs", step,
+                            "" if step is None else
+                            f"fastest rounds {manipulator['gym.make']['min_us']:.1f} µs, "
+                            f"unwrapped {manipulator['unwrapped']['median_us']:.1f} µs")]
+    for record in single:
+        if not record["ours"]:
+            continue
+        ratio = record["ratios"].get(ACROBOT)
+        targets.append(R.target_row(
+            f"{R.short_name(record['env_id'])} env.step ≥ 3× faster than {ACROBOT} "
+            "(Acrobot time / ours, medians)", "≥", TARGETS["speedup_vs_acrobot"], "×",
+            None if ratio is None else ratio["ratio_median"],
+            "" if ratio is None else f"fastest rounds {ratio['ratio_fastest']:.2f}×, "
+            f"unwrapped {ratio['ratio_median_unwrapped']:.2f}×"))
+    rows = [r for r in vector if r["env_id"] == MANIPULATOR and r["mode"] == "vector_entry_point"]
+    wanted = TARGETS["manipulator_vector_copies"]
+    at = [r for r in rows if r["num_envs"] == wanted]
+    best = max(rows, key=lambda r: r["physics_steps_per_s"]) if rows else None
+    note = ("" if best is None else
+            f"best over N: {best['physics_steps_per_s']:.3g} at N = {best['num_envs']}")
+    if not at and rows:
+        largest = max(rows, key=lambda r: r["num_envs"])
+        note = (f"N = {wanted} not run (quick); at N = {largest['num_envs']}: "
+                f"{largest['physics_steps_per_s']:.3g}; " + note)
+    targets.append(R.target_row(
+        f"manipulator vector env physics steps/s at num_envs = {wanted}, one core", "≥",
+        TARGETS["manipulator_physics_steps_per_s"], "1/s",
+        at[0]["physics_steps_per_s"] if at else None, note))
+    return targets
+
+
+def _load_text() -> str:
+    """The 1-minute load average, for progress lines."""
+    load = load_average()
+    return f"{load[0]:.2f}" if load else "n/a"
+
+
+def _pin(cpu: int | None) -> tuple[set[int] | None, dict[str, Any]]:
+    """Pin the process to ``cpu``; return (the previous affinity or None, a JSON note)."""
+    if cpu is None or not hasattr(os, "sched_setaffinity"):
+        return None, {"pinned": False, "cpus": sorted(os.sched_getaffinity(0))
+                      if hasattr(os, "sched_getaffinity") else None}
+    previous = os.sched_getaffinity(0)
+    try:
+        os.sched_setaffinity(0, {cpu})
+    except OSError as error:
+        return None, {"pinned": False, "error": _error_text(error), "cpus": sorted(previous)}
+    return previous, {"pinned": True, "cpus": sorted(os.sched_getaffinity(0))}
+
+
+def _numba_info() -> dict[str, Any]:
+    """Numba's threading settings (the env kernels are not parallel, so they run on 1 thread)."""
+    try:
+        import numba
+    except ImportError:
+        return {}
+    return {"num_threads": numba.config.NUMBA_NUM_THREADS,
+            "threading_layer": numba.config.THREADING_LAYER,
+            "parallel_kernels_used": False}
+
+
+def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None] | None = None
+        ) -> str:
+    """Run the whole benchmark, write the outputs and return the Markdown report."""
+    progress = Progress()
+    log = log or progress
+    output.mkdir(parents=True, exist_ok=True)
+    previous, pinning = _pin(config.cpu)
+    try:
+        env_ids = tuple(config.env_ids if config.env_ids is not None else mdi_envs.ENV_IDS)
+        record: dict[str, Any] = {
+            "machine": machine_info(VERSIONED),
+            "pinning": pinning,
+            "numba_threading": _numba_info(),
+            "config": {"quick": quick, "env_ids": env_ids,
+                       **{k: v for k, v in asdict(config).items() if k != "env_ids"}},
+            "units": UNITS,
+            "targets_brief": TARGETS,
+            "notes": [],
+            "load_log": [],
+        }
+        log(f"env benchmark ({'quick' if quick else 'full'}) -> {output}; pinned to "
+            f"{pinning['cpus']}; load {_load_text()}")
+        record["load_log"].append({"section": "single env", "elapsed_s": progress.elapsed,
+                                   "load_average": load_average()})
+        single, unavailable = single_env_study(env_ids, config.peers, config, log)
+        record["load_log"].append({"section": "vector env", "elapsed_s": progress.elapsed,
+                                   "load_average": load_average()})
+        vector, vector_unavailable = vector_study(env_ids, config, log)
+        record["load_log"].append({"section": "end", "elapsed_s": progress.elapsed,
+                                   "load_average": load_average()})
+        for item in (*unavailable, *vector_unavailable):
+            record["notes"].append(f"{item['env_id']}"
+                                   f"{' (' + item['mode'] + ')' if 'mode' in item else ''} "
+                                   f"not measured: {item['error']}")
+        record.update({
+            "single_env": single,
+            "unavailable": unavailable,
+            "vector_env": vector,
+            "vector_unavailable": vector_unavailable,
+            "targets": evaluate_targets(single, vector),
+        })
+        R.plot_step(single, unavailable, TARGETS, output / "envs_step.png")
+        R.plot_vector(vector, TARGETS, output / "envs_vector.png")
+        record["machine"]["load_average_at_end"] = load_average()
+        record["run_time_s"] = progress.elapsed
+        report.write_json(record, output / "envs.json")
+        log(f"done in {progress.elapsed:.0f} s; wrote envs.json, envs_step.png and "
+            f"envs_vector.png to {output}")
+    finally:
+        if previous is not None:
+            os.sched_setaffinity(0, previous)
+    return R.markdown_report(record)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
+    parser.add_argument("--quick", action="store_true",
+                        help="N up to 256 and small budgets (the JIT compile still dominates)")
+    parser.add_argument("--cpu", type=int, default=0,
+                        help="CPU to pin the process to (-1: no pinning)")
+    args = parser.parse_args(argv)
+    config = QUICK if args.quick else FULL
+    config = replace(config, cpu=None if args.cpu < 0 else args.cpu)
+    print(run(config, args.output, args.quick))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,241 @@
+"""Reporting of ``benchmarks.envs``: Markdown tables, target checks and plots."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks.report import format_ratio, markdown_table, plt
+
+SHORT_NAMES = {
+    "mdi_envs/BlockableManipulator-v0": "BlockableManipulator",
+    "mdi_envs/DiffDriveRobot-v0": "DiffDriveRobot",
+}
+
+
+def short_name(env_id: str) -> str:
+    """A short label: ``mdi_envs/BlockableManipulator-v0`` -> ``BlockableManipulator``."""
+    if env_id in SHORT_NAMES:
+        return SHORT_NAMES[env_id]
+    name = env_id.split("/")[-1]
+    return name[:-3] if env_id.startswith("mdi_envs/") and name.endswith("-v0") else name
+
+
+def _number(value: float, unit: str) -> str:
+    if unit == "µs":
+        return f"{value:.1f} µs" if value < 100 else f"{value:,.0f} µs"
+    if unit == "×":
+        return f"{value:.2f}×"
+    return f"{value:.3g} {unit}"
+
+
+def target_row(name: str, comparison: str, threshold: float, unit: str, value: float | None,
+               note: str = "") -> dict[str, Any]:
+    """One target check (``comparison`` "≤" or "≥"); met is None when nothing was measured."""
+    met = None
+    if value is not None:
+        met = bool(value <= threshold) if comparison == "≤" else bool(value >= threshold)
+    return {"target": name, "comparison": comparison, "threshold": threshold, "unit": unit,
+            "measured": value, "met": met, "note": note}
+
+
+def targets_table(targets: Sequence[dict[str, Any]]) -> str:
+    """Markdown: target, threshold, measured, ✓/✗, note."""
+    rows = []
+    for t in targets:
+        mark = "not measured" if t["met"] is None else ("✓" if t["met"] else "✗")
+        measured = "–" if t["measured"] is None else _number(t["measured"], t["unit"])
+        rows.append([t["target"], f"{t['comparison']} {_number(t['threshold'], t['unit'])}",
+                     measured, mark, t["note"]])
+    return markdown_table(["target", "threshold", "measured", "met", "note"], rows)
+
+
+def single_table(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]]) -> str:
+    """Markdown: per env the step times, frame_skip, µs per physics step and the ratios."""
+    peers = [r["env_id"] for r in single if not r["ours"]]
+    rows = []
+    for r in single:
+        wrapped, bare = r["gym.make"], r["unwrapped"]
+        ratios = [
+            "–" if not r["ours"] or peer not in r.get("ratios", {})
+            else format_ratio(r["ratios"][peer]["ratio_median"])
+            for peer in peers
+        ]
+        rows.append([
+            f"{short_name(r['env_id'])}{'' if r['ours'] else ' (peer)'}",
+            f"{wrapped['median_us']:.1f} ({wrapped['q1_us']:.1f}–{wrapped['q3_us']:.1f})",
+            f"{wrapped['min_us']:.1f}",
+            f"{bare['median_us']:.1f}",
+            str(r["frame_skip"]),
+            f"{r['per_physics_step_us']:.1f}",
+            f"{r['first_make_s'] + r['first_reset_s'] + r['first_step_s']:.2f}",
+            *ratios,
+        ])
+    for item in unavailable:
+        rows.append([f"{short_name(item['env_id'])} (peer)",
+                     f"not measured: {item['error']}", "", "", "", "", "",
+                     *("" for _ in peers)])
+    header = ["env", "env.step µs, gym.make (median, quartiles)", "fastest round µs",
+              "unwrapped µs", "frame_skip", "µs per physics step (gym.make)",
+              "first make+reset+step s", *(f"{short_name(p)} / ours" for p in peers)]
+    return markdown_table(header, rows)
+
+
+def vector_table(vector: Sequence[dict[str, Any]]) -> str:
+    """Markdown: rows N, columns env (mode): env-steps/s · physics steps/s."""
+    columns = list(dict.fromkeys((r["env_id"], r["mode"]) for r in vector))
+    sizes = sorted({r["num_envs"] for r in vector})
+    index = {(r["env_id"], r["mode"], r["num_envs"]): r for r in vector}
+    rows = []
+    for n in sizes:
+        cells = []
+        for env_id, mode in columns:
+            r = index.get((env_id, mode, n))
+            cells.append("–" if r is None else
+                         f"{r['env_steps_per_s']:.3g} · {r['physics_steps_per_s']:.3g}")
+        rows.append([str(n), *cells])
+    header = ["num_envs", *(f"{short_name(e)} ({'sync' if m == 'sync' else 'vector'})"
+                            for e, m in columns)]
+    return markdown_table(header, rows)
+
+
+def markdown_report(record: Mapping[str, Any]) -> str:
+    """All result tables of one run, as printed on stdout and pasted into the README."""
+    machine = record["machine"]
+    versions = machine["versions"]
+    start = machine.get("load_average_at_start") or []
+    end = machine.get("load_average_at_end") or []
+    load_text = (f"load average (1/5/15 min) {'/'.join(f'{x:.2f}' for x in start)} at start, "
+                 f"{'/'.join(f'{x:.2f}' for x in end)} at end")
+    pinning = record["pinning"]
+    pin_text = (f"pinned to CPU {pinning['cpus']}" if pinning.get("pinned")
+                else f"not pinned (CPUs {pinning.get('cpus')})")
+    lines = [
+        f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs, "
+        f"{pin_text}), Python {machine['python']}, numpy {versions.get('numpy')}, numba "
+        f"{versions.get('numba')}, gymnasium {versions.get('gymnasium')}, mujoco "
+        f"{versions.get('mujoco')}; total {record['run_time_s']:.0f} s"
+        f"{' (--quick)' if record['config']['quick'] else ''}; {load_text}.",
+    ]
+    if record["notes"]:
+        lines += ["", *(f"* {note}" for note in record["notes"])]
+    lines += ["", "**Targets**", "", targets_table(record["targets"])]
+    lines += ["", "**One env, `env.step`** (µs per step with a pre-sampled action, reset when "
+              "an episode ends; gym.make = TimeLimit, OrderEnforcing, PassiveEnvChecker; "
+              "ratios: peer time / our time through gym.make, > 1: ours faster)", "",
+              single_table(record["single_env"], record["unavailable"])]
+    if record["vector_env"]:
+        lines += ["", "**Vector env throughput** (env-steps/s · physics steps/s = env-steps/s × "
+                  "frame_skip; ours: `gym.make_vec(id, num_envs=N, vectorization_mode="
+                  "\"vector_entry_point\")`, Acrobot: `\"sync\"`; medians)", "",
+                  vector_table(record["vector_env"])]
+    return "\n".join(lines)
+
+
+def _save(fig: Any, path: Path) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def plot_step(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]],
+              targets: Mapping[str, float], path: Path) -> None:
+    """Bars of ``env.step`` µs per env (gym.make and unwrapped), with the targets as lines."""
+    labels = [short_name(r["env_id"]) + ("" if r["ours"] else "\n(peer)") for r in single]
+    labels += [short_name(u["env_id"]) + "\n(peer)" for u in unavailable]
+    x = np.arange(len(labels))
+    fig, ax = plt.subplots(figsize=(max(6.5, 1.6 * len(labels) + 2.0), 4.8))
+    width = 0.38
+    for offset, entry, color in ((-0.5, "gym.make", "tab:blue"), (0.5, "unwrapped", "tab:gray")):
+        med = [r[entry]["median_us"] for r in single]
+        err = [[r[entry]["median_us"] - r[entry]["q1_us"] for r in single],
+               [r[entry]["q3_us"] - r[entry]["median_us"] for r in single]]
+        colors = [color if entry != "gym.make" or r["ours"] else "tab:orange" for r in single]
+        bars = ax.bar(x[:len(single)] + offset * width, med, width, yerr=err, capsize=3,
+                      color=colors, label=f"env.step, {entry}" if entry == "unwrapped"
+                      else "env.step through gym.make (ours blue, peers orange)")
+        for bar, value in zip(bars, med, strict=True):
+            ax.text(bar.get_x() + bar.get_width() / 2, 0.6, f"{value:.1f}", ha="center",
+                    va="bottom", fontsize=7, color="white", fontweight="bold")
+    for i, item in enumerate(unavailable):
+        ax.text(len(single) + i, 1.0, "not measured:\n" + item["error"][:60].replace(": ", ":\n"),
+                ha="center", va="bottom", fontsize=6, color="tab:red")
+    ax.axhline(targets["manipulator_step_us"], color="tab:green", ls=":", lw=1.2,
+               label=f"target: manipulator ≤ {targets['manipulator_step_us']:g} µs")
+    acrobot = [r for r in single if r["env_id"] == "Acrobot-v1"]
+    if acrobot:
+        bound = acrobot[0]["gym.make"]["median_us"] / targets["speedup_vs_acrobot"]
+        ax.axhline(bound, color="tab:red", ls="--", lw=1.0,
+                   label=f"target: {targets['speedup_vs_acrobot']:g}× faster than Acrobot-v1 "
+                   f"(≤ {bound:.1f} µs)")
+    ax.set_yscale("log")
+    ax.set_ylim(bottom=0.5)
+    ax.set_xticks(x, labels, fontsize=8)
+    ax.set_ylabel("µs per env.step (median; bars: quartiles)")
+    ax.grid(True, axis="y", which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, frameon=False,
+              title="One environment: env.step time (lower is better)",
+              title_fontproperties={"size": 10})
+    _save(fig, path)
+
+
+def plot_vector(vector: Sequence[dict[str, Any]], targets: Mapping[str, float], path: Path
+                ) -> None:
+    """Env-steps/s and physics steps/s against num_envs (log-log), with the target line."""
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    columns = list(dict.fromkeys((r["env_id"], r["mode"]) for r in vector))
+    sizes = sorted({r["num_envs"] for r in vector})
+    manipulator_skip = None
+    for ax, key, title in ((axes[0], "env_steps_per_s", "env-steps/s"),
+                           (axes[1], "physics_steps_per_s", "physics steps/s (× frame_skip)")):
+        for env_id, mode in columns:
+            rows = sorted((r for r in vector if r["env_id"] == env_id and r["mode"] == mode),
+                          key=lambda r: r["num_envs"])
+            if env_id == "mdi_envs/BlockableManipulator-v0":
+                manipulator_skip = rows[0]["frame_skip"]
+            n = [r["num_envs"] for r in rows]
+            style = "--" if mode == "sync" else "-"
+            (line,) = ax.plot(n, [r[key] for r in rows], style, marker="o", ms=4,
+                              label=f"{short_name(env_id)} ({mode}, frame_skip "
+                              f"{rows[0]['frame_skip']})")
+            ax.fill_between(n, [r[f"{key}_q1"] for r in rows], [r[f"{key}_q3"] for r in rows],
+                            color=line.get_color(), alpha=0.15)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ticks = sorted({*sizes, targets["manipulator_vector_copies"]} if key.startswith("phys")
+                       else set(sizes))
+        if ticks:
+            ax.set_xticks(ticks, [str(s) for s in ticks])
+        ax.minorticks_off()
+        ax.set_xlabel("num_envs N (one core)")
+        ax.set_ylabel(f"{title} (median; band: quartiles)")
+        ax.grid(True, which="both", alpha=0.3)
+    goal = targets["manipulator_physics_steps_per_s"]
+    at = targets["manipulator_vector_copies"]
+    axes[1].axhline(goal, color="k", ls=":", lw=1.2,
+                    label=f"target: manipulator ≥ {goal:.0e} physics steps/s at N = {at}")
+    axes[1].plot([at], [goal], "k*", ms=10)
+    if manipulator_skip:
+        axes[0].axhline(goal / manipulator_skip, color="k", ls=":", lw=1.2,
+                        label=f"the same target in manipulator env-steps/s "
+                        f"({goal / manipulator_skip:.1e}, frame_skip {manipulator_skip})")
+    axes[0].set_title("Vector env throughput: env-steps/s")
+    axes[1].set_title("Vector env throughput: physics steps/s")
+    for ax in axes:
+        ax.legend(fontsize=7, loc="best")
+    _save(fig, path)
+
+
+__all__ = [
+    "markdown_report",
+    "plot_step",
+    "plot_vector",
+    "short_name",
+    "single_table",
+    "target_row",
+    "targets_table",
+    "vector_table",
+]
