@@ -132,6 +132,7 @@ class MoreauJeanTask:
         shortcuts: StepShortcuts | None = None,
     ) -> None:
         self._constants_cache: FloatArray | None = None
+        self._kernels: tuple[Any, Any, Any] | None = None
         self._info_keys = BASE_INFO_KEYS + self.INFO_KEYS
         self._typed_keys = tuple(
             (key, _INFO_TYPES[key]) for key in self._info_keys if key in _INFO_TYPES)
@@ -162,6 +163,14 @@ class MoreauJeanTask:
         self.goal_weight = _nonnegative("goal_weight", goal_weight)
         self.effort_weight = _nonnegative("effort_weight", effort_weight)
         self.reset_noise_scale = _nonnegative("reset_noise_scale", reset_noise_scale)
+        self._settings = np.array([
+            self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
+            self.effort_weight, self.goal_weight, self.shaping_weight, self.shaping_discount,
+        ])  # read by the compiled ``advance`` (see ``_compiled``)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle without the compiled kernels (rebuilt on first use)."""
+        return {**self.__dict__, "_kernels": None}
 
     @property
     def _constants(self) -> FloatArray:
@@ -225,14 +234,13 @@ class MoreauJeanTask:
         Raises:
             RuntimeError: the physics produced a non-finite state.
         """
-        self.stepper.step_batch(state.q, state.u, state.tau, state.brake, self.frame_skip,
-                                check_inputs=False, out=(state.impulses, state.physics))
-        finite = _compiled(type(self))[0](
-            state.q, state.u, state.tau, state.brake, state.impulses, state.physics,
-            self._constants, self.dt, self.num_horizon_steps, self.effort_weight,
-            self.goal_weight, self.shaping_weight, self.shaping_discount, state.elapsed_steps,
-            state.effort, state.potential, state.terminated, state.reward, state.obs,
-            state.info,
+        if self._kernels is None:
+            self._kernels = _compiled(type(self), self.stepper.compiled_step_batch[0])
+        _, record, workspace = self.stepper.compiled_step_batch
+        finite = self._kernels[0](
+            state.q, state.u, state.tau, state.brake, state.impulses, state.physics, record,
+            workspace, self._settings, self._constants, state.elapsed_steps, state.effort,
+            state.potential, state.terminated, state.reward, state.obs, state.info,
         )
         if not finite:
             raise RuntimeError(
@@ -254,8 +262,9 @@ class MoreauJeanTask:
 
     def observe(self, state: BatchState) -> Any:
         """Recompute every copy's observation into ``state.obs`` and return it."""
-        _compiled(type(self))[1](state.q, state.u, state.brake, state.elapsed_steps,
-                                 self.num_horizon_steps, self.dt, self._constants, state.obs)
+        observe_all = _compiled(type(self), self.stepper.compiled_step_batch[0])[1]
+        observe_all(state.q, state.u, state.brake, state.elapsed_steps, self.num_horizon_steps,
+                    self.dt, self._constants, state.obs)
         return state.obs
 
     def reset_copy(self, state: BatchState, index: int, rng: np.random.Generator) -> None:
@@ -272,7 +281,8 @@ class MoreauJeanTask:
 
     def update_potential(self, state: BatchState, index: int) -> None:
         """Phi of copy ``index`` after its state was set from outside the step."""
-        distance = _compiled(type(self))[2](state.q[index], state.u[index], self._constants)
+        distance_one = _compiled(type(self), self.stepper.compiled_step_batch[0])[2]
+        distance = distance_one(state.q[index], state.u[index], self._constants)
         state.potential[index] = -self.shaping_weight * distance
 
     def noise(self, rng: np.random.Generator, size: int) -> FloatArray:
@@ -490,16 +500,20 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         return self.state.obs.copy(), reward, terminated, truncated, infos
 
 
-_COMPILED: dict[type[MoreauJeanTask], tuple[Any, Any, Any]] = {}
+_COMPILED: dict[tuple[type[MoreauJeanTask], Any], tuple[Any, Any, Any]] = {}
 
 
-def _compiled(task: type[MoreauJeanTask]) -> tuple[Any, Any, Any]:
-    """The batched kernels of ``task`` (compiled once per task class and process).
+def _compiled(task: type[MoreauJeanTask], step_batch: Any) -> tuple[Any, Any, Any]:
+    """The batched kernels of ``task`` on the stepper kernel ``step_batch`` (compiled once per
+    pair and process).
 
-    Returns (evaluate, observe_all, distance_one); see ``MoreauJeanTask.advance``.
+    Returns (advance, observe_all, distance_one). ``advance`` runs the physics substeps and
+    then the rewards, observations and info of every copy in one compiled call (one dispatch
+    from Python per env step).
     """
-    if task in _COMPILED:
-        return _COMPILED[task]
+    key = (task, step_batch)
+    if key in _COMPILED:
+        return _COMPILED[key]
     observe_one = njit(task.observe_one)
     distance_one = njit(task.distance_one)
     success_one = njit(task.success_one)
@@ -551,13 +565,22 @@ def _compiled(task: type[MoreauJeanTask]) -> tuple[Any, Any, Any]:
         return finite
 
     @njit
+    def advance(q, u, tau, brake, impulses, physics, record, workspace, settings,  # noqa: ANN001
+                c, elapsed, effort, potential, terminated, reward, obs, info):
+        step_batch(q, u, tau, brake, settings[0], record, int(settings[1]), impulses, physics,
+                   workspace)
+        return evaluate(q, u, tau, brake, impulses, physics, c, settings[2], int(settings[3]),
+                        settings[4], settings[5], settings[6], settings[7], elapsed, effort,
+                        potential, terminated, reward, obs, info)
+
+    @njit
     def observe_all(q, u, brake, elapsed, horizon, dt, c, obs):  # noqa: ANN001
         for i in range(q.shape[0]):
             time_left = (horizon - elapsed[i]) * dt if horizon > 0 else 0.0
             observe_one(q[i], u[i], brake[i], time_left, c, obs[i])
 
-    _COMPILED[task] = (evaluate, observe_all, distance_one)
-    return _COMPILED[task]
+    _COMPILED[key] = (advance, observe_all, distance_one)
+    return _COMPILED[key]
 
 
 __all__ = ["BatchState", "MoreauJeanEnv", "MoreauJeanTask", "MoreauJeanVectorEnv"]

@@ -144,6 +144,15 @@ class MoreauJeanStepper:
         return (type(self), (self.model, self.parameters, self.time_step, self.shortcuts))
 
     @property
+    def compiled_step_batch(self) -> tuple[Any, Any, Any]:
+        """(kernel, parameter record, workspace) for callers fusing the step into their kernels.
+
+        ``kernel(q, u, tau, brake, dt, record, num_substeps, impulses, info, workspace)`` does
+        what ``step_batch(..., check_inputs=False)`` does.
+        """
+        return self._step_batch, self._values, self._workspace
+
+    @property
     def info_size(self) -> int:
         """Columns of the per-copy diagnostics ``step_batch`` returns."""
         return self._info_size
