@@ -1,7 +1,8 @@
 """The ``mdi-envs`` command line: one tool for the project's main jobs.
 
-Subcommands so far: ``demo`` (solvers and the manipulator) and ``solve`` (one Siconos file).
-Simulation, optimization, training and benchmarks arrive with the layers that provide them.
+Subcommands: ``demo`` (solvers and the manipulator), ``solve`` (one Siconos file),
+``simulate`` (one episode of an environment, optionally saved as GIF/MP4) and ``optimize``
+(an optimal-control reference). Training and the benchmark suite arrive with their issues.
 Each subcommand imports what it needs inside its handler.
 """
 
@@ -59,10 +60,77 @@ def _build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--method", default="lemke", help="LCP method (default: lemke)")
     solve.set_defaults(handler=_run_solve)
 
+    simulate = commands.add_parser(
+        "simulate",
+        help="play one episode of an environment (random, a saved policy, open-loop actions or "
+        "an optimal reference) and optionally save a GIF/MP4",
+        description="Run one episode of ENV_ID and print its length, return, success, elapsed "
+        "time and effort. POLICY is 'random', a trained SB3 model (.zip, with --algo), a file "
+        "of normalised actions (.npy or .csv, one row per step) or 'reference:NAME' (the "
+        "open-loop controls of a shipped optimal reference, at its own time step).",
+    )
+    simulate.add_argument("env_id", help="e.g. mdi_envs/BlockableManipulator-v0")
+    simulate.add_argument("--policy", default="random", help="see above (default: random)")
+    simulate.add_argument("--algo", default="PPO", help="SB3 algorithm of a .zip policy")
+    simulate.add_argument("--seed", type=int, default=0, help="reset seed")
+    simulate.add_argument("--steps", type=int, default=None, help="stop after this many steps")
+    simulate.add_argument("--save", type=Path, default=None, help="write a .gif or .mp4")
+    simulate.add_argument("--human", action="store_true", help="show a window while playing")
+    simulate.add_argument("--env-arg", action="append", default=[], metavar="KEY=VALUE",
+                          help="environment argument, e.g. task=effort (repeatable)")
+    simulate.set_defaults(handler=_run_simulate)
+
     from optimal.cli import add_optimize_parser
 
     add_optimize_parser(commands)
     return parser
+
+
+def _env_argument(text: str) -> tuple[str, Any]:
+    """KEY=VALUE with VALUE read as a Python literal when it is one (numbers, booleans)."""
+    import ast
+
+    key, separator, value = text.partition("=")
+    if not separator or not key:
+        raise SystemExit(f"--env-arg expects KEY=VALUE, got {text!r}")
+    try:
+        return key, ast.literal_eval(value)
+    except (ValueError, SyntaxError):
+        return key, value
+
+
+def _run_simulate(args: argparse.Namespace) -> int:
+    from mdi_envs.rendering import save_animation
+    from mdi_envs.rollout import load_actions, open_loop_policy, rollout
+
+    env_kwargs = dict(_env_argument(text) for text in args.env_arg)
+    policy: Any = args.policy
+    if policy.startswith("reference:"):
+        from optimal import load_reference
+        from optimal.replay import env_actions, env_options
+
+        reference = load_reference(policy.partition(":")[2])
+        env_kwargs = {**env_options(reference), **env_kwargs}
+        policy = open_loop_policy(env_actions(reference))
+    elif policy.endswith(".zip"):
+        import stable_baselines3
+
+        model = getattr(stable_baselines3, args.algo).load(policy, device="cpu")
+        policy = lambda obs: model.predict(obs, deterministic=True)[0]  # noqa: E731
+    elif policy != "random":
+        policy = open_loop_policy(load_actions(Path(policy)))
+    result = rollout(args.env_id, policy, seed=args.seed, max_steps=args.steps,
+                     record=args.save is not None, render_mode="human" if args.human else None,
+                     **env_kwargs)  # fmt: skip
+    info = result.last_info
+    end = "terminated" if result.terminated else "truncated" if result.truncated else "stopped"
+    print(f"{args.env_id}: {result.num_steps} steps ({end}), return {result.total_reward:.4f}, "
+          f"success {info.get('is_success')}, elapsed {info.get('elapsed_time', 0.0):.3f} s, "
+          f"effort {info.get('effort', 0.0):.4g} N^2 m^2 s")  # fmt: skip
+    if args.save is not None:
+        path = save_animation(result.frames, args.save, fps=30)
+        print(f"wrote {path}")
+    return 0
 
 
 def _contact_like_lcp(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:

@@ -103,9 +103,6 @@ def replay(
     return report, np.array(qs), np.array(us), np.array(modes, dtype=np.int64)
 
 
-__all__ = ["ReplayReport", "goal_errors", "replay"]
-
-
 def env_actions(reference: Reference) -> FloatArray:
     """The reference's controls as the env's default normalised Box actions, (N, a).
 
@@ -116,6 +113,21 @@ def env_actions(reference: Reference) -> FloatArray:
     if reference.brake_bound.shape[1]:
         actions.append(np.where(reference.brake_bound > 0.0, 1.0, -1.0))
     return np.hstack(actions).astype(np.float32)
+
+
+def env_options(reference: Reference) -> dict[str, Any]:
+    """``gym.make`` keyword arguments under which one env step is one reference interval.
+
+    time_step = h, frame_skip = 1, no start noise, the reference's torque bound, an episode
+    limit of N steps, plus the metadata's ``env_kwargs`` (e.g. ``task="effort"``).
+    """
+    meta = reference.metadata
+    bound_name = "max_torque" if reference.brake_bound.shape[1] else "max_wheel_torque"
+    options: dict[str, Any] = {"time_step": reference.time_step, "frame_skip": 1,
+                               "reset_noise_scale": 0.0, bound_name: meta["torque_bound"],
+                               "max_episode_steps": len(reference.tau)}
+    options.update(meta.get("env_kwargs", {}))
+    return options
 
 
 def replay_in_env(reference: Reference) -> tuple[FloatArray, dict[str, Any]]:
@@ -129,12 +141,7 @@ def replay_in_env(reference: Reference) -> tuple[FloatArray, dict[str, Any]]:
 
     import mdi_envs  # noqa: F401 - registers the ids
 
-    meta = reference.metadata
-    bound_name = "max_torque" if reference.brake_bound.shape[1] else "max_wheel_torque"
-    options: dict[str, Any] = {"time_step": reference.time_step, "frame_skip": 1,
-                               "reset_noise_scale": 0.0, bound_name: meta["torque_bound"]}
-    options.update(meta.get("env_kwargs", {}))
-    env = gym.make(meta["env_id"], max_episode_steps=len(reference.tau), **options)
+    env = gym.make(reference.metadata["env_id"], **env_options(reference))
     env.reset(seed=0)
     info: dict[str, Any] = {}
     for action in env_actions(reference):
@@ -142,3 +149,6 @@ def replay_in_env(reference: Reference) -> tuple[FloatArray, dict[str, Any]]:
         if terminated or truncated:
             break
     return env.unwrapped.q, info
+
+
+__all__ = ["ReplayReport", "env_actions", "env_options", "goal_errors", "replay", "replay_in_env"]

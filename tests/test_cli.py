@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from mdi_envs.cli import main
@@ -47,3 +48,27 @@ def test_solve_reports_a_ray_with_exit_code(tmp_path: Path) -> None:
     path = tmp_path / "infeasible.dat"
     path.write_text("2\n0\n2\n2\n2 2\n-1 0\n0 -1\n-1 -1\n")
     assert main(["solve", str(path)]) == 1
+
+
+def test_simulate_replays_the_optimal_reference_to_success(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    gif = tmp_path / "ref.gif"
+    assert main(["simulate", "mdi_envs/BlockableManipulator-v0", "--policy",
+                 "reference:manipulator_time", "--save", str(gif)]) == 0
+    out = capsys.readouterr().out
+    assert "(terminated)" in out and "success True" in out
+    assert gif.stat().st_size > 0
+
+
+def test_simulate_open_loop_file_and_env_args(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    actions = tmp_path / "actions.csv"
+    np.savetxt(actions, np.tile([0.5, 0.5], (10, 1)), delimiter=",")
+    assert main(["simulate", "mdi_envs/DiffDriveRobot-v0", "--policy", str(actions),
+                 "--env-arg", "task=effort", "--steps", "10"]) == 0
+    out = capsys.readouterr().out
+    assert "10 steps (stopped)" in out and "elapsed 0.500 s" in out
+    with pytest.raises(ValueError, match=".npy or .csv"):
+        main(["simulate", "mdi_envs/DiffDriveRobot-v0", "--policy", str(tmp_path / "a.txt")])
