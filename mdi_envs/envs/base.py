@@ -452,19 +452,37 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
 
     def reset(self, *, seed: int | list[int | None] | None = None,
               options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:  # fmt: skip
-        """Reset every copy; ``seed`` an int (copy i gets seed + i), a list, or None."""
+        """Reset every copy; ``seed`` an int (copy i gets seed + i), a list, or None.
+
+        ``options={"reset_mask": mask}`` ((num_envs,) bool) resets only the masked copies, as
+        Gymnasium's vector envs do; the others keep their state. A copy reset without a seed
+        continues its own random stream.
+        """
+        mask = np.ones(self.num_envs, np.bool_)
+        if options is not None and "reset_mask" in options:
+            mask = options["reset_mask"]
+            _require(isinstance(mask, np.ndarray) and mask.dtype == np.bool_
+                     and mask.shape == (self.num_envs,),
+                     f"options['reset_mask'] must be a bool array of shape ({self.num_envs},)")
+            _require(bool(mask.any()) and (bool(mask.all()) or bool(self._rngs)),
+                     "options['reset_mask'] needs a True entry, and a full reset() first")
         if seed is None or isinstance(seed, (int, np.integer)):
             seeds = [None if seed is None else int(seed) + i for i in range(self.num_envs)]
         else:
             seeds = list(seed)
             _require(len(seeds) == self.num_envs,
                      f"seed list has {len(seeds)} entries for {self.num_envs} envs")
-        self._rngs = [seeding.np_random(s)[0] for s in seeds]
+        if mask.all():
+            self._rngs = [seeding.np_random(s)[0] for s in seeds]
+        else:  # a partial reset: seeded copies restart their stream, the others continue it
+            for i in np.flatnonzero(mask):
+                if seeds[i] is not None:
+                    self._rngs[i] = seeding.np_random(seeds[i])[0]
         if seed is not None:
             self._np_random, self._np_random_seed = seeding.np_random(seeds[0])
-        for i, rng in enumerate(self._rngs):
-            self.task.reset_copy(self.state, i, rng)
-        self._autoreset[:] = False
+        for i in np.flatnonzero(mask):
+            self.task.reset_copy(self.state, int(i), self._rngs[i])
+        self._autoreset[mask] = False
         return self.task.observe(self.state).copy(), {}
 
     def step(self, actions: Any) -> tuple[Any, FloatArray, BoolArray, BoolArray, dict[str, Any]]:

@@ -187,3 +187,25 @@ def test_info_has_every_documented_key(env_id: str) -> None:
     terms = info["reward_objective"] + info["reward_shaping"] + info["reward_goal"]
     assert reward == pytest.approx(terms, rel=1e-15, abs=1e-15)
     assert info["solver_status"] == 0
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS[:1])
+def test_partial_reset_matches_sync_vector_env(env_id: str) -> None:
+    """``reset(options={"reset_mask": ...})`` resets only the masked copies, as Sync does."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        envs = [gym.make_vec(env_id, num_envs=3, vectorization_mode=mode)
+                for mode in ("vector_entry_point", "sync")]
+    for env in envs:
+        env.reset(seed=2)
+    envs[0].action_space.seed(0)
+    mask = np.array([True, False, True])
+    for step in range(60):
+        actions = envs[0].action_space.sample()
+        results = [env.step(actions)[:4] for env in envs]
+        if step == 30:
+            results = [env.reset(options={"reset_mask": mask.copy()}) for env in envs]
+        np.testing.assert_array_equal(results[0][0], results[1][0])
+        np.testing.assert_array_equal(results[0][1], results[1][1])
+    with pytest.raises(ValueError, match="reset_mask"):
+        envs[0].reset(options={"reset_mask": np.zeros(3, bool)})
