@@ -828,7 +828,8 @@ def _save_mp4(frames: list[NDArray[np.uint8]], path: pathlib.Path, fps: int) -> 
             "MP4 animations need imageio and imageio-ffmpeg: pip install imageio imageio-ffmpeg "
             "(or save a .gif, which needs only Pillow)"
         ) from error
-    imageio.mimwrite(path, np.stack(frames), format="FFMPEG", fps=fps, macro_block_size=1)
+    images: list[Any] = list(frames)
+    imageio.mimwrite(path, images, format="FFMPEG", fps=fps, macro_block_size=1)
 
 
 __all__ = [

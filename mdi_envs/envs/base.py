@@ -23,7 +23,6 @@ and small arrays, compiled with numba into one batched kernel per task class, so
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -36,6 +35,7 @@ from numba import njit
 
 from mdi_envs._types import BoolArray, FloatArray
 from mdi_envs.mechanics.models.base import ModelDefinition
+from mdi_envs.mechanics.parameters import require_nonnegative, require_positive
 from mdi_envs.stepping._kernel import (
     INFO_ACTIVE_CONTACTS,
     INFO_ITERATIONS,
@@ -62,13 +62,6 @@ def _require(condition: bool, message: str) -> None:
         raise ValueError(message)
 
 
-def _positive(name: str, value: Any) -> float:
-    _require(isinstance(value, (int, float)) and not isinstance(value, bool)
-             and math.isfinite(value) and value > 0, f"{name} must be a finite number > 0, "
-             f"got {value!r}")  # fmt: skip
-    return float(value)
-
-
 def build_parameters(parameters: Any, defaults: type[Any], **overrides: Any) -> Any:
     """``parameters`` (default ``defaults()``) with the non-None ``overrides`` replaced.
 
@@ -79,13 +72,6 @@ def build_parameters(parameters: Any, defaults: type[Any], **overrides: Any) -> 
         raise ValueError(f"parameters must be a {defaults.__name__}, got {type(base).__name__}")
     changes = {name: value for name, value in overrides.items() if value is not None}
     return dataclasses.replace(base, **changes) if changes else base
-
-
-def _nonnegative(name: str, value: Any) -> float:
-    _require(isinstance(value, (int, float)) and not isinstance(value, bool)
-             and math.isfinite(value) and value >= 0, f"{name} must be a finite number >= 0, "
-             f"got {value!r}")  # fmt: skip
-    return float(value)
 
 
 class MoreauJeanTask:
@@ -141,7 +127,7 @@ class MoreauJeanTask:
         _require(objective in self.OBJECTIVE_OPTIONS,
                  f"objective must be one of {self.OBJECTIVE_OPTIONS}, got {objective!r}")
         self.stepper = MoreauJeanStepper(
-            self.MODEL, parameters, _positive("time_step", time_step),
+            self.MODEL, parameters, require_positive("time_step", time_step),
             shortcuts if shortcuts is not None else StepShortcuts(),
         )
         self.parameters = self.stepper.parameters
@@ -150,19 +136,20 @@ class MoreauJeanTask:
         self.objective = objective
         self.num_horizon_steps = 0
         if objective == "effort":
-            horizon = _positive("final_time", final_time)
+            _require(final_time is not None, "objective 'effort' needs a final_time")
+            horizon = require_positive("final_time", float(final_time))  # type: ignore[arg-type]
             self.num_horizon_steps = round(horizon / self.dt)
             _require(abs(self.num_horizon_steps * self.dt - horizon) <= 1e-9 * horizon,
                      f"final_time {horizon} s must be a whole number of env steps of "
                      f"{self.dt} s (time_step * frame_skip)")  # fmt: skip
         self.final_time = self.num_horizon_steps * self.dt
-        self.shaping_weight = _nonnegative("shaping_weight", shaping_weight)
-        self.shaping_discount = _positive("shaping_discount", shaping_discount)
+        self.shaping_weight = require_nonnegative("shaping_weight", shaping_weight)
+        self.shaping_discount = require_positive("shaping_discount", shaping_discount)
         _require(self.shaping_discount <= 1.0,
                  f"shaping_discount must lie in (0, 1], got {shaping_discount!r}")
-        self.goal_weight = _nonnegative("goal_weight", goal_weight)
-        self.effort_weight = _nonnegative("effort_weight", effort_weight)
-        self.reset_noise_scale = _nonnegative("reset_noise_scale", reset_noise_scale)
+        self.goal_weight = require_nonnegative("goal_weight", goal_weight)
+        self.effort_weight = require_nonnegative("effort_weight", effort_weight)
+        self.reset_noise_scale = require_nonnegative("reset_noise_scale", reset_noise_scale)
         self._settings = np.array([
             self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
             self.effort_weight, self.goal_weight, self.shaping_weight, self.shaping_discount,

@@ -17,9 +17,9 @@ from mdi_envs.envs.base import (
     MoreauJeanEnv,
     MoreauJeanTask,
     MoreauJeanVectorEnv,
-    _positive,
 )
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulator
+from mdi_envs.mechanics.parameters import require_positive
 from mdi_envs.tasks import MANIPULATOR_TASK
 
 VELOCITY_WEIGHT = 0.3  # [s] weight of the speeds in the goal distance (rad/s -> rad)
@@ -44,8 +44,8 @@ class BlockableManipulatorTask(MoreauJeanTask):
     ) -> None:
         super().__init__(time_step=time_step, frame_skip=frame_skip,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
-        self.max_torque = _positive("max_torque", max_torque)
-        self.max_brake_torque = _positive("max_brake_torque", max_brake_torque)
+        self.max_torque = require_positive("max_torque", max_torque)
+        self.max_brake_torque = require_positive("max_brake_torque", max_brake_torque)
         if action_mode not in ACTION_MODES:
             raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
         self.action_mode = action_mode

@@ -17,10 +17,10 @@ from mdi_envs.envs.base import (
     MoreauJeanEnv,
     MoreauJeanTask,
     MoreauJeanVectorEnv,
-    _positive,
     build_parameters,
 )
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBall, BouncingBallParameters
+from mdi_envs.mechanics.parameters import require_positive
 
 GOAL_X = 1.0  # [m] horizontal goal of the ball's centre
 INITIAL_HEIGHT = 1.0  # [m] height of the ball's centre at the start (at rest)
@@ -54,7 +54,7 @@ class BouncingBallTask(MoreauJeanTask):
                                       friction_coefficient=friction_coefficient)  # fmt: skip
         super().__init__(parameters=parameters, time_step=time_step, frame_skip=frame_skip,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
-        self.max_force = _positive("max_force", max_force)
+        self.max_force = require_positive("max_force", max_force)
         if not INITIAL_HEIGHT > self.parameters.radius:
             raise ValueError(f"parameter 'radius' must be < the drop height {INITIAL_HEIGHT} m, "
                              f"got {self.parameters.radius!r}")  # fmt: skip

@@ -14,8 +14,8 @@ from gymnasium import spaces
 from mdi_envs._types import FloatArray
 from mdi_envs.envs._actions import decode_torque_and_brake, torque_brake_space
 from mdi_envs.envs.base import BatchState, MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
-from mdi_envs.envs.base import _positive as positive
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
+from mdi_envs.mechanics.parameters import require_positive
 from mdi_envs.stepping._spatial_kernel import INFO_LIFTED_CONTACTS, INFO_MODE, INFO_RESIDUAL
 from mdi_envs.tasks import DIFF_DRIVE_TASK
 
@@ -49,7 +49,7 @@ class DiffDriveRobotTask(MoreauJeanTask):
         super().__init__(time_step=time_step, frame_skip=frame_skip, objective=task,
                          final_time=DIFF_DRIVE_TASK.effort_final_time,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
-        self.max_wheel_torque = positive("max_wheel_torque", max_wheel_torque)
+        self.max_wheel_torque = require_positive("max_wheel_torque", max_wheel_torque)
         self.single_action_space = torque_brake_space("box", num_torques=2, has_brake=False)
         high = np.full(self.NUM_OBSERVATIONS, np.inf, np.float32)
         high[2:4] = 1.0

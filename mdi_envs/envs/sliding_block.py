@@ -17,10 +17,10 @@ from mdi_envs.envs.base import (
     MoreauJeanEnv,
     MoreauJeanTask,
     MoreauJeanVectorEnv,
-    _positive,
     build_parameters,
 )
 from mdi_envs.mechanics.models.sliding_block import SlidingBlock, SlidingBlockParameters
+from mdi_envs.mechanics.parameters import require_positive
 
 GOAL_S = -0.5  # [m] goal position along the slope (0.5 m up-slope of the start)
 POSITION_TOLERANCE = 0.02  # [m] |s - GOAL_S| at success
@@ -55,7 +55,7 @@ class SlidingBlockTask(MoreauJeanTask):
                                       friction_coefficient=friction_coefficient)  # fmt: skip
         super().__init__(parameters=parameters, time_step=time_step, frame_skip=frame_skip,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
-        self.max_force = _positive("max_force", max_force)
+        self.max_force = require_positive("max_force", max_force)
         self.single_action_space = torque_brake_space("box", num_torques=1, has_brake=False)
         high = np.array([np.inf, np.inf, 1.0], np.float32)
         low = np.array([-np.inf, -np.inf, 0.0], np.float32)
