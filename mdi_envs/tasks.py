@@ -51,7 +51,12 @@ class DiffDriveTask:
         initial_pose: (x [m], y [m], phi [rad]) at t = 0, at rest.
         goal_pose: (x, y, phi) to reach at rest.
         max_wheel_torque: |tau_L|, |tau_R| bound [N m]; above the rolling traction limit of the
-            default robot (about 2.2 N m per wheel), so that the optimum may slip.
+            default robot (about 2.2 N m per wheel), so that the optimum may slip. Not
+            calibrated to the paper's 4.03 s (the paper gives no robot parameters): with the
+            default robot ``mdi-envs optimize diff_drive_time`` takes 3.16 s at 3.0 N m through
+            5-, 3- and 2-DOF modes like the paper's Fig. 8, while 4.03 s would need about 1.6 N m
+            (3.95 s at 1.66 N m), below the traction limit, where both maneuvers roll throughout
+            (2-DOF only) and the stick-slip character of the paper's maneuvers is lost.
         effort_final_time: maneuver A's fixed final time [s] (the paper's 4.05 s).
         position_tolerance: success when |(x, y) - goal| is within this [m] ...
         heading_tolerance: ... the wrapped heading error within this [rad] ...

@@ -30,7 +30,8 @@ def add_optimize_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help="folder for NAME.npz, NAME.json and the PNGs")
     parser.add_argument("--intervals", type=int, default=None, help="N (default: the problem's)")
     parser.add_argument("--install", action="store_true",
-                        help="also write the reference into optimal/references (package data)")
+                        help="also write the reference into optimal/references (package data), "
+                        "if it converged and its replay reaches the goal")
     parser.set_defaults(handler=run_optimize)
     return parser
 
@@ -50,9 +51,11 @@ def run_optimize(args: argparse.Namespace) -> int:
     print(f"saved {path} and {path.with_suffix('.npz')}")
     for png in plot_reference(reference, args.output):
         print(f"saved {png}")
-    if args.install:
-        print(f"installed {save_reference(reference, REFERENCE_DIR)}")
     ok = meta["converged"] and meta["replay"][0]["reaches_goal"]
+    if args.install and ok:
+        print(f"installed {save_reference(reference, REFERENCE_DIR)}")
+    elif args.install:
+        print("not installed: the continuation did not converge or the replay misses the goal")
     return 0 if ok else 1
 
 

@@ -12,6 +12,10 @@ import numpy as np
 
 from optimal.references import Reference
 
+SLIDING_SPEED = 1e-6
+"""[m/s] a wheel counts as sliding above this slip speed (as ``optimal.solve.SLIP_TOLERANCE``
+with the robot's 1 m/s velocity unit)."""
+
 
 def plot_reference(reference: Reference, directory: Path | str) -> list[Path]:
     """Save the reference's figures into ``directory``; returns the PNG paths."""
@@ -74,22 +78,30 @@ def _robot(reference: Reference, folder: Path) -> list[Path]:
 
     t, q, h = reference.time, reference.q, reference.time_step
     modes = reference.arrays["mode"]
+    sliding = reference.arrays["slip_speed"][:, :2] > SLIDING_SPEED
     fig, ax = plt.subplots(figsize=(5, 6))
-    colours = {2: "tab:green", 3: "tab:orange", 5: "tab:red"}
-    for mode, colour in colours.items():
-        chosen = np.flatnonzero(modes == mode)
-        if chosen.size:
-            ax.scatter(q[chosen + 1, 0], q[chosen + 1, 1], s=8, color=colour,
-                       label=f"{mode}-DOF mode")
+    classes = {
+        "2-DOF mode (both wheels roll)": (modes == 2, "tab:green"),
+        "3L-DOF mode (left wheel slides)": ((modes == 3) & sliding[:, 0], "tab:orange"),
+        "3R-DOF mode (right wheel slides)": ((modes == 3) & sliding[:, 1], "tab:purple"),
+        "5-DOF mode (both slide)": (modes == 5, "tab:red"),
+    }
+    for label, (chosen, colour) in classes.items():
+        if np.any(chosen):
+            index = np.flatnonzero(chosen) + 1
+            ax.scatter(q[index, 0], q[index, 1], s=8, color=colour, label=label)
+    every = max(1, len(q) // 20)
+    ax.quiver(q[::every, 0], q[::every, 1], np.cos(q[::every, 2]), np.sin(q[::every, 2]),
+              angles="xy", scale=12, width=0.004, color="0.3", label="heading")
     ax.plot(q[:, 0], q[:, 1], color="0.6", lw=0.8, zorder=0)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_aspect("equal")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
     ax.grid(alpha=0.3)
     ax.set_title(f"{reference.name}: t_f = {reference.final_time:.2f} s (cf. Figs. 7-8)")
     first = folder / f"{reference.name}_path.png"
-    fig.savefig(first, dpi=110)
+    fig.savefig(first, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
     fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex=True)

@@ -110,7 +110,7 @@ def env_actions(reference: Reference) -> FloatArray:
     +1 (engaged, ideal) where its bound is positive and -1 (released) elsewhere.
     """
     actions = [reference.tau / reference.metadata["torque_bound"]]
-    if reference.brake_bound.shape[1]:
+    if reference.brake_bound is not None and reference.brake_bound.shape[1]:
         actions.append(np.where(reference.brake_bound > 0.0, 1.0, -1.0))
     return np.hstack(actions).astype(np.float32)
 
@@ -122,7 +122,8 @@ def env_options(reference: Reference) -> dict[str, Any]:
     limit of N steps, plus the metadata's ``env_kwargs`` (e.g. ``task="effort"``).
     """
     meta = reference.metadata
-    bound_name = "max_torque" if reference.brake_bound.shape[1] else "max_wheel_torque"
+    has_brake = reference.brake_bound is not None and reference.brake_bound.shape[1]
+    bound_name = "max_torque" if has_brake else "max_wheel_torque"
     options: dict[str, Any] = {"time_step": reference.time_step, "frame_skip": 1,
                                "reset_noise_scale": 0.0, bound_name: meta["torque_bound"],
                                "max_episode_steps": len(reference.tau)}

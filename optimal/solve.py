@@ -36,6 +36,12 @@ GUESS_TIME_FACTORS = {"manipulator_time": (0.66, 0.88, 1.0, 1.1, 1.32)}
 converged solution kept (the manipulator's problem has many local optima). Problems not listed
 start once."""
 
+SCHEDULES = {"diff_drive_time": Schedule(mu_strategy="monotone"),
+             "diff_drive_effort": Schedule(mu_strategy="monotone")}
+"""Per-problem continuation schedules (others: ``Schedule()``). The robot's first stage, from
+the naive guess far from complementarity, takes 5-20x fewer IPOPT iterations with the monotone
+barrier update."""
+
 ENV_VERSION = 0
 """The ``-vN`` of the environment ids the references are computed for."""
 
@@ -58,6 +64,7 @@ def solve_problem(
         complementarity residual <= 1e-6.
     """
     base = make_problem(name, num_intervals)
+    schedule = schedule or SCHEDULES.get(name)
     model, parameters = model_of(base)
     start = time.perf_counter()
     guesses = GUESS_TIME_FACTORS.get(name, (1.0,))
@@ -70,6 +77,7 @@ def solve_problem(
             progress(f"{name}: {problem.description}; N = {problem.num_intervals}, "
                      f"naive guess t_f = {problem.final_time:.3f} s")
         result = solve_continuation(transcription, schedule, progress)
+        transcription = result.transcription or transcription
         cost = float(result.values(transcription.cost))
         starts.append({"guess_final_time": problem.final_time, "cost": cost,
                        "converged": result.success,
@@ -110,6 +118,7 @@ def solve_problem(
         "description": problem.description,
         "env_id": problem.env_id,
         "env_version": ENV_VERSION,
+        "env_kwargs": dict(problem.env_kwargs),
         "model": model.NAME,
         "parameters": dataclasses.asdict(parameters),
         "method": "midpoint transcription, penalty/continuation (SUMT) + active-set polish, "

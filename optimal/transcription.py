@@ -27,7 +27,8 @@ rho sum a b whose weight rises and a relaxation a b <= r that falls). The laws, 
   (no contact lifts off), slip xi_T = W_T u_{k+1} (2,), and with the slip speed lam >= 0 and the
   cone slack s = mu^2 P_N^2 - |P_T|^2 >= 0:  mu P_N xi_T + lam P_T = 0 and the pair (lam, s).
   Sliding (lam > 0) puts P_T on the cone boundary against the slip, |xi_T| = lam; sticking
-  (lam = 0) gives xi_T = 0.
+  (lam = 0) gives xi_T = 0. In the last interval, when u_N = 0 is imposed, every slip is zero
+  and only the cone is stated; the polish (``Transcription.polished``) fixes the modes.
 
 The NLP is nondimensional: every variable is stored in the problem's units (``time_scale``,
 ``velocity_scale``, ``impulse_scale``, ``length_scale``; inputs in units of ``torque_bound``)
@@ -57,8 +58,10 @@ IMPLICIT_THETA = 0.5
 TANGENT_REGULARIZATION = 1e-6
 """Weight of sum |P_T / impulse_scale|^2 / N in the objective of load-transfer models: the rigid
 robot leaves the split of the lateral impulse between its two wheels undetermined (their
-lateral rows coincide), which makes IPOPT's KKT matrix singular; this picks the least-norm
-split and changes the cost by less than this weight."""
+lateral rows coincide), which leaves a direction of the NLP without curvature; this picks the
+least-norm split and changes the cost by less than this weight. (The coinciding rows also make
+the two wheels' sticking laws duplicate constraints -- a rank-deficient Jacobian that no
+objective term repairs; ``Transcription.polished`` states them once.)"""
 
 
 @dataclass(frozen=True)
@@ -82,6 +85,8 @@ class OptimalControlProblem:
         length_scale: [m] unit of gaps in them and of the coordinates' kinematic equations.
         time_scale: [s] unit of t_f (and of the time-optimal cost).
         env_id: the environment the reference is meant for (metadata).
+        env_kwargs: (key, value) pairs for ``gym.make(env_id, ...)`` (metadata), e.g. the
+            robot's ``task="effort"``.
         description: one line for humans.
     """
 
@@ -103,6 +108,7 @@ class OptimalControlProblem:
     length_scale: float = 1.0
     time_scale: float = 1.0
     env_id: str = ""
+    env_kwargs: tuple[tuple[str, Any], ...] = ()
     description: str = ""
 
 
@@ -126,7 +132,9 @@ class Transcription:
     """The NLP of one problem, built once; ``continuation`` solves it stage by stage.
 
     Attributes:
-        problem: the problem transcribed. opti: the ``casadi.Opti`` instance.
+        problem: the problem transcribed. active_set: None, or for load-transfer contacts a
+            (c, N) boolean array (True: the contact slides over the interval) that fixes the
+            modes: the polish NLP (see ``polished``). opti: the ``casadi.Opti`` instance.
         q: (n, N+1) coordinates. u: (n, N+1) velocities. tau: (m, N) inputs.
         final_time: t_f (a variable or a float). step: h = t_f / N.
         rho: penalty weight (parameter). relaxation: bound r on each scaled product (parameter).
@@ -135,6 +143,7 @@ class Transcription:
     """
 
     problem: OptimalControlProblem
+    active_set: Any = None
     opti: Any = field(init=False)
     q: Any = field(init=False)
     u: Any = field(init=False)
@@ -148,6 +157,7 @@ class Transcription:
     outputs: dict[str, Any] = field(init=False, default_factory=dict)
     _slack_guesses: list[tuple[Any, Callable[[], Any]]] = field(init=False, default_factory=list)
     _raw: dict[int, tuple[Any, float]] = field(init=False, default_factory=dict)
+    _cone_slack: Any = field(init=False, default=None)
 
     def __post_init__(self) -> None:
         import casadi
@@ -185,7 +195,8 @@ class Transcription:
         if c and model.HAS_LOAD_TRANSFER:
             if d != 3:
                 raise NotImplementedError("load-transfer contacts are transcribed in 3-D only")
-            contact = _LoadTransferLaw(opti, self.variable, model, values, big_n, s_imp, s_vel)
+            contact = _LoadTransferLaw(opti, self.variable, model, values, big_n, s_imp, s_vel,
+                                       self.active_set)
         elif c:
             if any(mu > 0.0 for mu in model.friction_coefficients(values)) or d != 2:
                 raise NotImplementedError("gap contacts are transcribed without friction only")
@@ -201,7 +212,9 @@ class Transcription:
             if gap is not None:
                 generalized += gap.interval(i, eq.gaps(qm), eq.contact_rows(qm), uk, u_next)
             if contact is not None:
-                generalized += contact.interval(i, h, eq.contact_rows(qm), u_next)
+                # at rest after the last step every slip is zero: the law reduces to the cone
+                at_rest = i == big_n - 1 and set(pr.goal_u) == set(range(n))
+                generalized += contact.interval(i, h, eq.contact_rows(qm), u_next, at_rest)
             opti.subject_to((eq.mass(qm) @ (u_next - uk) - generalized) / s_imp == 0)
             opti.subject_to((self.q[:, i + 1] - qm - h / 2 * u_next) / s_len == 0)
 
@@ -231,6 +244,7 @@ class Transcription:
                                    s_vel * s_imp**2))
             self.outputs.update(normal_impulse=contact.normal, tangent_impulse=contact.tangent,
                                 slip_speed=contact.slip_speed, slip_velocity=contact.slip)
+            self._cone_slack = contact.cone_slack
             self._slack_guesses += contact.guesses
 
         if pr.cost == "time":
@@ -248,6 +262,22 @@ class Transcription:
             penalty += casadi.sum1(casadi.vec(products))
             opti.subject_to(casadi.vec(products) <= self.relaxation)
         opti.minimize(self.cost / cost_unit + (self.rho * penalty + regularization) / big_n)
+
+    def polished(self, values: Callable[[Any], Any]) -> Transcription:
+        """The polish NLP of a load-transfer model at the modes of the point ``values``.
+
+        A contact slides over an interval where its slip speed exceeds the scaled cone slack
+        (the larger side of the pair), else sticks. The new NLP has the same variables (so
+        ``opti.x`` carries over) and states each mode's law exactly and without repeated rows:
+        sticking fixes the slip speed to 0 and the slip W_T u_{k+1} to 0, with the rows that
+        repeat a sticking row of another contact (the two wheels' lateral slip) stated once;
+        sliding fixes the cone slack to 0 and keeps mu P_N xi_T + lam P_T = 0.
+        """
+        contact_slip = np.asarray(values(self.outputs["slip_speed"]), dtype=float)
+        cone = np.asarray(values(self._cone_slack), dtype=float)
+        pr = self.problem
+        sliding = contact_slip / pr.velocity_scale > cone / pr.impulse_scale**2
+        return Transcription(pr, active_set=sliding)
 
     def set_naive_guess(self) -> None:
         """The documented naive initial guess.
@@ -427,9 +457,11 @@ class _LoadTransferLaw:
     num_intervals: int
     impulse_unit: float
     velocity_unit: float
+    active_set: Any = None
 
     def __post_init__(self) -> None:
         c = self.model.NUM_CONTACTS
+        self._same_row = _identical_tangent_rows(self.model, self.values)
         self.tangent = self.new((2 * c, self.num_intervals), self.impulse_unit)
         self.slip_speed = self.new((c, self.num_intervals), self.velocity_unit, True)
         self.cone_slack = self.new((c, self.num_intervals), self.impulse_unit**2, True)
@@ -441,8 +473,12 @@ class _LoadTransferLaw:
         self._slips: list[Any] = []
         self._cones: list[Any] = []
 
-    def interval(self, i: int, h: Any, rows: Any, u_next: Any) -> Any:
-        """Generalized friction impulse W_T^T P_T of interval i, with its laws."""
+    def interval(self, i: int, h: Any, rows: Any, u_next: Any, at_rest: bool = False) -> Any:
+        """Generalized friction impulse W_T^T P_T of interval i, with its laws.
+
+        ``at_rest``: u_{k+1} = 0 is imposed, so every slip is zero and the law reduces to P_T
+        in the cone with slip speed 0 (stating it would repeat the rows of u_{k+1} = 0).
+        """
         import casadi
 
         c = self.model.NUM_CONTACTS
@@ -450,16 +486,28 @@ class _LoadTransferLaw:
         p_t = self.tangent[:, i]
         p_n = self._n0 * h + self._gain @ p_t
         slip = tangent_rows @ u_next
-        unit = self.impulse_unit
+        unit, speed_unit = self.impulse_unit, self.velocity_unit
         self.opti.subject_to(p_n / unit >= 0)
         cones = []
+        stated: list[int] = []  # rows of W_T already set to zero in this interval
         for j in range(c):
             pj, sj = p_t[2 * j:2 * j + 2], slip[2 * j:2 * j + 2]
-            self.opti.subject_to(
-                (self._mu[j] * p_n[j] * sj + self.slip_speed[j, i] * pj)
-                / (unit * self.velocity_unit) == 0
-            )
             cones.append((self._mu[j] * p_n[j]) ** 2 - casadi.sumsqr(pj))
+            if at_rest:
+                self.opti.subject_to(self.slip_speed[j, i] / speed_unit == 0)
+            elif self.active_set is not None and not self.active_set[j, i]:  # sticks
+                self.opti.subject_to(self.slip_speed[j, i] / speed_unit == 0)
+                for row in (2 * j, 2 * j + 1):
+                    if not any(self._same_row[row, other] for other in stated):
+                        self.opti.subject_to(slip[row] / speed_unit == 0)
+                        stated.append(row)
+            else:
+                self.opti.subject_to(
+                    (self._mu[j] * p_n[j] * sj + self.slip_speed[j, i] * pj)
+                    / (unit * speed_unit) == 0
+                )
+                if self.active_set is not None:  # slides: on the cone
+                    self.opti.subject_to(self.cone_slack[j, i] / unit**2 == 0)
         cone = casadi.vertcat(*cones)
         self.opti.subject_to((self.cone_slack[:, i] - cone) / unit**2 == 0)
         self._normals.append(p_n)
@@ -490,6 +538,30 @@ class _LoadTransferLaw:
         return [(self.tangent, lambda: 0 * self.tangent),
                 (self.slip_speed, lambda: 0 * self.slip_speed),
                 (self.cone_slack, lambda: cones)]
+
+
+def _identical_tangent_rows(model: type[ModelDefinition], values: Any) -> np.ndarray:
+    """(2c, 2c) booleans: which tangent rows of W coincide for every q.
+
+    For the robot: the two wheels' lateral rows. Found by evaluating the rows at three random
+    configurations.
+    """
+    import math
+
+    class _Ops:
+        cos, sin = staticmethod(math.cos), staticmethod(math.sin)
+
+    rng = np.random.default_rng(0)
+    c, d = model.NUM_CONTACTS, model.CONTACT_DIMENSION
+    tangent = [j for j in range(c * d) if j % d]
+    samples = [np.asarray(model.contact_directions(rng.normal(size=model.NUM_DOFS), values,
+                                                   _Ops), dtype=float)[tangent]
+               for _ in range(3)]
+    same = np.ones((len(tangent), len(tangent)), dtype=bool)
+    for rows in samples:
+        same &= np.all(np.isclose(rows[:, None, :], rows[None, :, :], rtol=0.0, atol=1e-12),
+                       axis=2)
+    return same
 
 
 def numeric(value: Any) -> FloatArray:

@@ -63,4 +63,7 @@ def test_reference_replays_to_the_goal_in_the_gym_env(name: str) -> None:
     q, info = replay_in_env(reference)
     assert info["is_success"], info
     assert info["elapsed_time"] == pytest.approx(reference.final_time, rel=1e-9)
-    np.testing.assert_allclose(q, reference.q[-1], atol=1e-6)
+    # the env takes float32 actions (torques rounded to ~6e-8 relative); over the robot's
+    # maneuver this moves the wheel angles by up to ~2e-5 rad, the manipulator's by < 1e-6
+    atol = 1e-6 if reference.brake_bound is not None else 1e-4
+    np.testing.assert_allclose(q, reference.q[-1], atol=atol)

@@ -62,3 +62,25 @@ def test_ball_drop_reaches_complementarity_and_matches_the_simulator() -> None:
 def test_schedule_validates_its_stages() -> None:
     with pytest.raises(ValueError, match="equal length"):
         Schedule(penalties=(1.0, 2.0), relaxations=(0.1,))
+
+
+def test_robot_lateral_wheel_rows_are_found_identical() -> None:
+    """The polish states the two wheels' shared lateral no-slip row once (else LICQ fails)."""
+    from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
+    from optimal.transcription import _identical_tangent_rows
+
+    same = _identical_tangent_rows(DiffDriveRobot, DiffDriveRobot.Parameters().values())
+    # tangent rows: (L x, L y, R x, R y, stick x, stick y)
+    expected = np.eye(6, dtype=bool)
+    expected[1, 3] = expected[3, 1] = True
+    np.testing.assert_array_equal(same, expected)
+
+
+def test_robot_polish_nlp_has_the_same_variables() -> None:
+    """``polished`` rebuilds the NLP with fixed modes but the same variable layout."""
+    transcription = Transcription(make_problem("diff_drive_time", 6))
+    transcription.set_naive_guess()
+    opti = transcription.opti
+    polished = transcription.polished(lambda expression: opti.value(expression, opti.initial()))
+    assert polished.opti.nx == transcription.opti.nx
+    assert polished.active_set.shape == (3, 6)
