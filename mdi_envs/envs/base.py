@@ -136,8 +136,9 @@ class MoreauJeanTask:
         self.objective = objective
         self.num_horizon_steps = 0
         if objective == "effort":
-            _require(final_time is not None, "objective 'effort' needs a final_time")
-            horizon = require_positive("final_time", float(final_time))  # type: ignore[arg-type]
+            if final_time is None:
+                raise ValueError("objective 'effort' needs a final_time")
+            horizon = require_positive("final_time", final_time)
             self.num_horizon_steps = round(horizon / self.dt)
             _require(abs(self.num_horizon_steps * self.dt - horizon) <= 1e-9 * horizon,
                      f"final_time {horizon} s must be a whole number of env steps of "
