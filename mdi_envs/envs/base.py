@@ -444,7 +444,7 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
 
         ``options={"reset_mask": mask}`` ((num_envs,) bool) resets only the masked copies, as
         Gymnasium's vector envs do; the others keep their state. A copy reset without a seed
-        continues its own random stream.
+        continues its own random stream (fresh entropy on the very first reset).
         """
         mask = np.ones(self.num_envs, np.bool_)
         if options is not None and "reset_mask" in options:
@@ -460,9 +460,9 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
             seeds = list(seed)
             _require(len(seeds) == self.num_envs,
                      f"seed list has {len(seeds)} entries for {self.num_envs} envs")
-        if mask.all():
+        if not self._rngs:
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
-        else:  # a partial reset: seeded copies restart their stream, the others continue it
+        else:  # as gymnasium's Env.reset: a seed restarts the copy's stream, None continues it
             for i in np.flatnonzero(mask):
                 if seeds[i] is not None:
                     self._rngs[i] = seeding.np_random(seeds[i])[0]

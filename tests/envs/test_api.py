@@ -209,3 +209,16 @@ def test_partial_reset_matches_sync_vector_env(env_id: str) -> None:
         np.testing.assert_array_equal(results[0][1], results[1][1])
     with pytest.raises(ValueError, match="reset_mask"):
         envs[0].reset(options={"reset_mask": np.zeros(3, bool)})
+
+
+def test_unseeded_reset_continues_each_copys_stream_like_sync() -> None:
+    env_id = ENV_IDS[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        envs = [gym.make_vec(env_id, num_envs=2, vectorization_mode=mode)
+                for mode in ("vector_entry_point", "sync")]
+    first = [env.reset(seed=7)[0] for env in envs]
+    second = [env.reset()[0] for env in envs]
+    np.testing.assert_array_equal(first[0], first[1])
+    np.testing.assert_array_equal(second[0], second[1])
+    assert not np.array_equal(first[0], second[0])
