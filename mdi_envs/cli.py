@@ -45,7 +45,9 @@ def _build_parser() -> argparse.ArgumentParser:
         description="Solve random contact-like LCPs (n = 2..100) with every registered method "
         "and print a table of status, iterations, residual and time; then run the blockable "
         "manipulator under the paper's brake schedule by time-stepping and by the event-driven "
-        "reference. Saves PNG plots. Takes about 30 s (mostly numba compilation).",
+        "reference; then replay every shipped optimal reference open loop through its "
+        "Gymnasium env. Saves PNG plots and GIFs. Takes about 1-2 min (mostly numba "
+        "compilation).",
     )
     demo.add_argument("--output", type=Path, default=Path("results/demo"), help="PNG folder")
     demo.add_argument("--seed", type=int, default=0, help="random seed of the problems")
@@ -179,9 +181,30 @@ def _run_demo(args: argparse.Namespace) -> int:
         ),
     ]
     written.append(_manipulator_demo(args.output))
+    written += _reference_replays(args.output)
     for path in written:
         print(f"wrote {path}")
     return 0
+
+
+def _reference_replays(output: Path) -> list[Path]:
+    """Replay each shipped optimal reference open loop through its gym env, saving a GIF."""
+    from mdi_envs.rendering import save_animation
+    from mdi_envs.rollout import open_loop_policy, rollout
+    from optimal import available_references, load_reference
+    from optimal.replay import env_actions, env_options
+
+    written = []
+    for name in available_references():
+        reference = load_reference(name)
+        result = rollout(reference.metadata["env_id"], open_loop_policy(env_actions(reference)),
+                         record=True, **env_options(reference))  # fmt: skip
+        info = result.last_info
+        print(f"optimal reference {name} replayed in {reference.metadata['env_id']}: "
+              f"{result.num_steps} steps, elapsed {info['elapsed_time']:.3f} s, "
+              f"success {info['is_success']}, effort {info['effort']:.4g} N^2 m^2 s")
+        written.append(save_animation(result.frames[::2], output / f"{name}.gif", fps=15))
+    return written
 
 
 def _manipulator_demo(output: Path) -> Path:

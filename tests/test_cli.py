@@ -28,8 +28,10 @@ def test_demo_writes_its_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str
     out = capsys.readouterr().out
     assert "CONVERGED" in out
     assert "max deviation from the event-driven reference" in out
+    assert "optimal reference manipulator_time replayed" in out and "success True" in out
+    assert "success False" not in out
     for name in ("lcp_methods_time.png", "lcp_complementarity.png",
-                 "manipulator_brake_schedule.png"):
+                 "manipulator_brake_schedule.png", "manipulator_time.gif"):
         assert (tmp_path / name).stat().st_size > 1000
 
 
