@@ -24,6 +24,11 @@ def register_envs() -> None:
             entry_point=f"mdi_envs.envs.{module}:{prefix}Env",
             vector_entry_point=f"mdi_envs.envs.{module}:{prefix}VectorEnv",
             max_episode_steps=max_episode_steps,
+            # The envs check reset-before-step and every action themselves (ResetNeeded,
+            # ValueError): Gymnasium's OrderEnforcing and passive checker wrappers would only
+            # repeat that, at ~1-2 us per step each.
+            order_enforce=False,
+            disable_env_checker=True,
         )
 
 
