@@ -82,9 +82,11 @@ def _build_parser() -> argparse.ArgumentParser:
                           help="environment argument, e.g. task=effort (repeatable)")
     simulate.set_defaults(handler=_run_simulate)
 
+    from baselines.cli import add_train_parser
     from optimal.cli import add_optimize_parser
 
     add_optimize_parser(commands)
+    add_train_parser(commands)
     return parser
 
 

@@ -1,0 +1,94 @@
+"""The one table of baseline settings, keyed by (env id, task, algorithm).
+
+Each entry holds the SB3 constructor arguments, the number of batched copies, the training
+budget, the seed and the environment arguments. Choices shared by every entry:
+
+- ``gamma = 0.99`` for both algorithms, passed to the env as ``shaping_discount`` (the shaping
+  term gamma Phi(s') - Phi(s) then leaves the optimal policy unchanged; ``train`` sets it).
+- PPO with many copies (64): the batched env steps them in one compiled call, so a rollout of
+  64 x 256 = 16384 steps costs about as much as a few hundred single-env steps; minibatches
+  of 2048, 10 epochs, GAE lambda 0.95, clip 0.2, no entropy bonus, 2 x 64 tanh MLPs (SB3's
+  defaults otherwise, as in rl-zoo's continuous-control settings).
+- SAC with fewer copies (8) and ``gradient_steps = num_envs`` (one gradient step per env
+  transition, SAC's usual replay ratio), 10^6 buffer, batch 256, 2 x 256 ReLU MLPs, automatic
+  entropy tuning, 10^4 random warm-up steps.
+- Budgets: PPO 3 x 10^6 steps, SAC 3 x 10^5 (episodes: manipulator up to 500 steps of 0.02 s,
+  the optimum takes about 228; diff drive "time" up to 200 steps of 0.05 s, "effort" exactly
+  81). Untuned starting points: the shipped results say how far they get.
+- Seed 0 everywhere; ``train(..., seed=...)`` overrides it.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
+DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
+ALGORITHMS = ("PPO", "SAC")
+
+_PPO: dict[str, Any] = {
+    "num_envs": 64,
+    "total_timesteps": 3_000_000,
+    "seed": 0,
+    "algo_kwargs": {
+        "n_steps": 256, "batch_size": 2048, "n_epochs": 10, "learning_rate": 3e-4,
+        "gamma": 0.99, "gae_lambda": 0.95, "clip_range": 0.2, "ent_coef": 0.0,
+        "max_grad_norm": 0.5,
+        "policy_kwargs": {"net_arch": {"pi": [64, 64], "vf": [64, 64]}},
+    },
+}
+_SAC: dict[str, Any] = {
+    "num_envs": 8,
+    "total_timesteps": 300_000,
+    "seed": 0,
+    "algo_kwargs": {
+        "buffer_size": 1_000_000, "batch_size": 256, "learning_rate": 3e-4, "gamma": 0.99,
+        "tau": 0.005, "learning_starts": 10_000, "train_freq": 1, "gradient_steps": 8,
+        "ent_coef": "auto", "policy_kwargs": {"net_arch": [256, 256]},
+    },
+}
+
+
+def _entry(base: dict[str, Any], env_kwargs: dict[str, Any]) -> dict[str, Any]:
+    return {**copy.deepcopy(base), "env_kwargs": dict(env_kwargs)}
+
+
+HYPERPARAMETERS: dict[tuple[str, str, str], dict[str, Any]] = {
+    (MANIPULATOR, "time", "PPO"): _entry(_PPO, {}),
+    (MANIPULATOR, "time", "SAC"): _entry(_SAC, {}),
+    (DIFF_DRIVE, "time", "PPO"): _entry(_PPO, {"task": "time"}),
+    (DIFF_DRIVE, "time", "SAC"): _entry(_SAC, {"task": "time"}),
+    (DIFF_DRIVE, "effort", "PPO"): _entry(_PPO, {"task": "effort"}),
+    (DIFF_DRIVE, "effort", "SAC"): _entry(_SAC, {"task": "effort"}),
+}
+"""(env id, task, algorithm) -> {"num_envs", "total_timesteps", "seed", "algo_kwargs" (SB3
+constructor arguments), "env_kwargs" (``gym.make`` arguments; ``shaping_discount`` is added
+from gamma)}."""
+
+DEFAULT_TASKS = {MANIPULATOR: "time", DIFF_DRIVE: "time"}
+"""The task used when none is given (the manipulator has only "time")."""
+
+
+def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict[str, Any]:
+    """A deep copy of the table entry, with ``env_kwargs["shaping_discount"] = gamma``.
+
+    Args:
+        env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
+        algo: "PPO" or "SAC" (case-insensitive).
+        task: "time" or "effort" (diff drive only); default ``DEFAULT_TASKS[env_id]``.
+
+    Raises:
+        KeyError: no entry for this combination (the message lists the known keys).
+    """
+    task = DEFAULT_TASKS.get(env_id) if task is None else task
+    key = (env_id, str(task), algo.upper())
+    if key not in HYPERPARAMETERS:
+        known = ", ".join(" ".join(k) for k in HYPERPARAMETERS)
+        raise KeyError(f"no hyperparameters for {' '.join(map(str, key))}; known: {known}")
+    entry = copy.deepcopy(HYPERPARAMETERS[key])
+    entry["env_kwargs"]["shaping_discount"] = entry["algo_kwargs"]["gamma"]
+    return entry
+
+
+__all__ = ["ALGORITHMS", "DEFAULT_TASKS", "HYPERPARAMETERS", "get_hyperparameters"]

@@ -1,0 +1,282 @@
+"""Train one SB3 baseline and save it next to its exact config, episode log and curves.
+
+``train("mdi_envs/DiffDriveRobot-v0", "PPO", task="effort", output=Path("results/baselines"))``
+checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched env through the
+``MoreauJeanVecEnv`` adapter wrapped in ``VecMonitor``, trains with the table's settings
+(``baselines.hyperparameters``), logs to TensorBoard, evaluates the deterministic policy with
+``evaluate_policy`` on ``gym.make`` copies, and writes into ``output``:
+
+- ``STEM.zip``: the SB3 model (``PPO.load``/``SAC.load``);
+- ``STEM.json``: env id, task, algorithm, seed, the exact SB3 and env arguments, budget,
+  package versions, git commit, wall time, training and evaluation scores;
+- ``STEM_episodes.csv``: one row per finished training episode (timesteps, return, length,
+  success, elapsed time [s], effort [N^2 m^2 s]);
+- ``STEM.png``: episode return and success rate vs environment steps;
+- ``tensorboard/STEM_1/``: SB3's TensorBoard logs (``tensorboard --logdir OUTPUT/tensorboard``);
+
+with STEM = ``{env name}_{task}_{algo}_seed{seed}``, e.g. ``DiffDriveRobot-v0_effort_ppo_seed0``.
+"""
+
+from __future__ import annotations
+
+import copy
+import csv
+import json
+import platform
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+
+import mdi_envs
+from baselines.hyperparameters import get_hyperparameters
+
+EPISODE_COLUMNS = ("timesteps", "return", "length", "is_success", "elapsed_time", "effort")
+"""Columns of ``STEM_episodes.csv`` (steps, -, steps, bool, s, N^2 m^2 s)."""
+
+
+class EpisodeLog(BaseCallback):
+    """Record every finished training episode from the ``VecMonitor`` infos.
+
+    Attributes:
+        rows: one tuple per episode, in ``EPISODE_COLUMNS`` order.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.rows: list[tuple[int, float, int, bool, float, float]] = []
+
+    def _on_step(self) -> bool:
+        for info in self.locals["infos"]:
+            episode = info.get("episode")
+            if episode is not None:
+                self.rows.append((int(self.num_timesteps), float(episode["r"]),
+                                  int(episode["l"]), bool(info.get("is_success", False)),
+                                  float(info.get("elapsed_time", np.nan)),
+                                  float(info.get("effort", np.nan))))  # fmt: skip
+        return True
+
+
+def run_name(env_id: str, task: str, algo: str, seed: int) -> str:
+    """The file stem of a run, e.g. ``BlockableManipulator-v0_time_ppo_seed0``."""
+    return f"{env_id.split('/')[-1]}_{task}_{algo.lower()}_seed{seed}"
+
+
+def check_single_env(env_id: str, env_kwargs: dict[str, Any]) -> None:
+    """Gymnasium's and SB3's ``check_env`` on ``gym.make(env_id, **env_kwargs)``.
+
+    Raises:
+        AssertionError: the env breaks the API (raised by the checkers).
+    """
+    from gymnasium.utils.env_checker import check_env as gym_check_env
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make(env_id, **env_kwargs)
+        gym_check_env(env.unwrapped, skip_render_check=True)
+        sb3_check_env(env, warn=False)
+    env.close()
+
+
+def train(
+    env_id: str,
+    algo: str,
+    task: str | None = None,
+    seed: int | None = None,
+    total_timesteps: int | None = None,
+    output: Path = Path("results/baselines"),
+    *,
+    num_envs: int | None = None,
+    algo_overrides: dict[str, Any] | None = None,
+    eval_episodes: int = 10,
+    progress_bar: bool | None = None,
+    verbose: int = 0,
+) -> Path:
+    """Train ``algo`` on ``env_id`` with the table's settings; returns the model's zip path.
+
+    Args:
+        env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
+        algo: "PPO" or "SAC".
+        task: "time" or "effort" (diff drive); default the env's "time".
+        seed: the run's seed (SB3's ``seed``: torch, the action noise and env copy i's
+            start states from seed + i); default the table's.
+        total_timesteps: environment steps to train (summed over copies); default the table's.
+        output: folder for the files listed in the module docstring (created).
+        num_envs: number of batched copies; default the table's.
+        algo_overrides: SB3 arguments replacing the table's (tests use tiny networks).
+        eval_episodes: deterministic evaluation episodes on ``gym.make`` after training.
+        progress_bar: SB3's progress bar (tqdm + rich); default when stderr is a terminal.
+        verbose: SB3's verbosity.
+    """
+    import stable_baselines3
+    import torch
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from baselines.vec_env import make_vec_env
+
+    entry = get_hyperparameters(env_id, algo, task)
+    algo = algo.upper()
+    task = entry["env_kwargs"].get("task", "time")
+    seed = entry["seed"] if seed is None else int(seed)
+    total_timesteps = entry["total_timesteps"] if total_timesteps is None else total_timesteps
+    num_envs = entry["num_envs"] if num_envs is None else int(num_envs)
+    algo_kwargs = {**entry["algo_kwargs"], **(algo_overrides or {})}
+    env_kwargs = {**entry["env_kwargs"], "shaping_discount": algo_kwargs["gamma"]}
+    if progress_bar is None:
+        progress_bar = sys.stderr.isatty()
+    output = Path(output)
+    output.mkdir(parents=True, exist_ok=True)
+    stem = run_name(env_id, task, algo, seed)
+
+    check_single_env(env_id, env_kwargs)
+    venv = VecMonitor(make_vec_env(env_id, num_envs, **env_kwargs))
+    model_class = getattr(stable_baselines3, algo)
+    model = model_class("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose,
+                        tensorboard_log=str(output / "tensorboard"),
+                        **copy.deepcopy(algo_kwargs))  # fmt: skip
+    log = EpisodeLog()
+    start = time.perf_counter()
+    model.learn(total_timesteps=total_timesteps, callback=log, tb_log_name=stem,
+                progress_bar=progress_bar)  # fmt: skip
+    wall_time = time.perf_counter() - start
+    model_path = output / f"{stem}.zip"
+    model.save(model_path)
+    venv.close()
+
+    evaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed=seed + 10_000)
+    write_episodes(log.rows, output / f"{stem}_episodes.csv")
+    recent = log.rows[-100:]
+    config = {
+        "env_id": env_id, "task": task, "algo": algo, "seed": seed,
+        "num_envs": num_envs, "total_timesteps": total_timesteps,
+        "num_timesteps": int(model.num_timesteps),
+        "algo_kwargs": algo_kwargs, "algo_overrides": algo_overrides or {},
+        "env_kwargs": env_kwargs, "policy": "MlpPolicy",
+        "device": "cpu", "torch_threads": torch.get_num_threads(),
+        "wall_time_s": wall_time, "num_episodes": len(log.rows),
+        "train_last100": {
+            "mean_return": float(np.mean([r[1] for r in recent])) if recent else None,
+            "success_rate": float(np.mean([r[3] for r in recent])) if recent else None,
+        },
+        "evaluation": evaluation,
+        "versions": versions(), "commit": git_commit(),
+        "date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "command": f"mdi-envs train {env_id} {algo} --task {task} --seed {seed} "
+                   f"--timesteps {total_timesteps} --num-envs {num_envs}"
+                   + (" (plus algo_overrides)" if algo_overrides else ""),
+    }
+    (output / f"{stem}.json").write_text(json.dumps(config, indent=2, default=str) + "\n")
+    plot_training(log.rows, output / f"{stem}.png", title=f"{stem} ({algo}, {num_envs} envs)")
+    return model_path
+
+
+def evaluate(model: Any, env_id: str, env_kwargs: dict[str, Any], episodes: int,
+             seed: int) -> dict[str, Any]:  # fmt: skip
+    """SB3's ``evaluate_policy`` (deterministic) on ``gym.make``; returns scores.
+
+    Returns:
+        {"episodes", "seed", "mean_return", "std_return", "mean_length" [steps],
+        "success_rate", "mean_elapsed_time" [s], "mean_effort" [N^2 m^2 s]}; None values when
+        ``episodes`` is 0.
+    """
+    from stable_baselines3.common.evaluation import evaluate_policy
+    from stable_baselines3.common.monitor import Monitor
+
+    result: dict[str, Any] = {"episodes": episodes, "seed": seed}
+    if episodes <= 0:
+        return result
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = Monitor(gym.make(env_id, **env_kwargs))
+    env.reset(seed=seed)
+    finals: list[dict[str, Any]] = []
+
+    def record(local_vars: dict[str, Any], _: dict[str, Any]) -> None:
+        if local_vars["done"]:
+            finals.append(local_vars["info"])
+
+    returns, lengths = evaluate_policy(model, env, n_eval_episodes=episodes, deterministic=True,
+                                       return_episode_rewards=True, callback=record)  # fmt: skip
+    env.close()
+    result.update({
+        "mean_return": float(np.mean(returns)), "std_return": float(np.std(returns)),
+        "mean_length": float(np.mean(lengths)),
+        "success_rate": float(np.mean([bool(i.get("is_success")) for i in finals])),
+        "mean_elapsed_time": float(np.mean([i.get("elapsed_time", np.nan) for i in finals])),
+        "mean_effort": float(np.mean([i.get("effort", np.nan) for i in finals])),
+    })
+    return result
+
+
+def write_episodes(rows: list[tuple[Any, ...]], path: Path) -> None:
+    """Write the episode log as CSV with ``EPISODE_COLUMNS``."""
+    with path.open("w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(EPISODE_COLUMNS)
+        writer.writerows(rows)
+
+
+def plot_training(rows: list[tuple[Any, ...]], path: Path, title: str = "",
+                  window: int = 100) -> None:  # fmt: skip
+    """Episode return and success rate vs environment steps (moving mean over ``window``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_return, ax_success) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    if rows:
+        data = np.array([r[:4] for r in rows], dtype=float)
+        steps, returns, success = data[:, 0], data[:, 1], data[:, 3]
+        kernel = np.ones(min(window, len(rows)))
+        counts = np.convolve(np.ones(len(rows)), kernel)[: len(rows)]
+        ax_return.plot(steps, returns, ".", ms=2, alpha=0.3, color="C0", label="episode")
+        ax_return.plot(steps, np.convolve(returns, kernel)[: len(rows)] / counts, color="C0",
+                       label=f"mean of last {len(kernel)}")  # fmt: skip
+        ax_success.plot(steps, np.convolve(success, kernel)[: len(rows)] / counts, color="C2")
+    else:
+        ax_return.text(0.5, 0.5, "no finished episode", ha="center", transform=ax_return.transAxes)
+    ax_return.set_ylabel("episode return [-]")
+    ax_return.legend(loc="lower right") if rows else None
+    ax_success.set_ylabel("success rate")
+    ax_success.set_ylim(-0.05, 1.05)
+    ax_success.set_xlabel("environment steps")
+    for ax in (ax_return, ax_success):
+        ax.grid(alpha=0.3)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def versions() -> dict[str, str]:
+    """Versions of Python and the packages a run depends on."""
+    import stable_baselines3
+    import torch
+
+    return {"python": platform.python_version(), "mdi_envs": mdi_envs.__version__,
+            "stable_baselines3": stable_baselines3.__version__, "torch": torch.__version__,
+            "gymnasium": gym.__version__, "numpy": np.__version__}  # fmt: skip
+
+
+def git_commit() -> str | None:
+    """The repository's HEAD commit ("+dirty" with uncommitted changes); None outside git."""
+    root = Path(__file__).resolve().parent.parent
+    try:
+        commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True,
+                                text=True, check=True, timeout=10).stdout.strip()  # fmt: skip
+        dirty = subprocess.run(["git", "status", "--porcelain"], cwd=root, capture_output=True,
+                               text=True, check=True, timeout=10).stdout.strip()  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return commit + ("+dirty" if dirty else "")
+
+
+__all__ = ["EpisodeLog", "check_single_env", "evaluate", "plot_training", "run_name", "train"]

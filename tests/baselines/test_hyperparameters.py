@@ -1,0 +1,30 @@
+"""The hyperparameter table: complete, consistent, and accepted by SB3 and the envs."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import pytest
+
+import mdi_envs  # noqa: F401 - registers the ids
+from baselines.hyperparameters import HYPERPARAMETERS, get_hyperparameters
+
+
+def test_table_covers_both_envs_tasks_and_algorithms() -> None:
+    assert len(HYPERPARAMETERS) == 6
+    for (env_id, task, algo), entry in HYPERPARAMETERS.items():
+        assert env_id in gym.registry and algo in ("PPO", "SAC") and task in ("time", "effort")
+        assert {"num_envs", "total_timesteps", "seed", "algo_kwargs", "env_kwargs"} <= set(entry)
+        assert isinstance(entry["seed"], int) and entry["num_envs"] >= 1
+        assert entry["algo_kwargs"]["gamma"] == 0.99
+
+
+def test_get_hyperparameters_sets_the_shaping_discount_and_copies() -> None:
+    entry = get_hyperparameters("mdi_envs/DiffDriveRobot-v0", "sac", "effort")
+    assert entry["env_kwargs"] == {"task": "effort", "shaping_discount": 0.99}
+    entry["algo_kwargs"]["gamma"] = 0.5
+    assert HYPERPARAMETERS[("mdi_envs/DiffDriveRobot-v0", "effort", "SAC")]["algo_kwargs"][
+        "gamma"] == 0.99
+    assert get_hyperparameters("mdi_envs/BlockableManipulator-v0", "PPO")["env_kwargs"] == {
+        "shaping_discount": 0.99}
+    with pytest.raises(KeyError, match="known"):
+        get_hyperparameters("mdi_envs/BlockableManipulator-v0", "PPO", "effort")

@@ -1,0 +1,95 @@
+"""Training smoke runs (<= 1000 steps) through ``train`` and the ``train`` subcommand."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from baselines.cli import add_train_parser
+from baselines.train import plot_training, run_name
+
+MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
+TINY = {"policy_kwargs": {"net_arch": [16, 16]}}
+
+
+@pytest.fixture(autouse=True)
+def _one_thread() -> None:
+    import torch
+
+    torch.set_num_threads(1)
+
+
+def _check_outputs(model_path: Path, algo: str, num_timesteps: int) -> dict:
+    for suffix in (".zip", ".json", ".png"):
+        assert model_path.with_suffix(suffix).stat().st_size > 0
+    config = json.loads(model_path.with_suffix(".json").read_text())
+    assert config["algo"] == algo and config["seed"] == 3
+    assert config["num_timesteps"] >= num_timesteps
+    assert config["env_kwargs"]["shaping_discount"] == config["algo_kwargs"]["gamma"]
+    assert config["algo_kwargs"]["policy_kwargs"] == TINY["policy_kwargs"]  # not SB3's copy
+    assert {"stable_baselines3", "torch", "gymnasium", "mdi_envs"} <= set(config["versions"])
+    assert config["num_episodes"] >= 1  # 500-step manipulator episodes end within the budget
+    assert np.isfinite(config["evaluation"]["mean_return"])
+    assert (model_path.parent / "tensorboard").is_dir()
+    rows = model_path.with_name(model_path.stem + "_episodes.csv").read_text().splitlines()
+    assert rows[0].startswith("timesteps,return") and len(rows) == config["num_episodes"] + 1
+    return config
+
+
+@pytest.mark.slow
+def test_train_ppo_smoke(tmp_path: Path) -> None:
+    from stable_baselines3 import PPO
+
+    from baselines.train import train
+
+    overrides = {"n_steps": 64, "batch_size": 64, "n_epochs": 2, **TINY}
+    path = train(MANIPULATOR, "ppo", seed=3, total_timesteps=1000, output=tmp_path,
+                 num_envs=2, algo_overrides=overrides, eval_episodes=1, progress_bar=False)
+    assert path == tmp_path / f"{run_name(MANIPULATOR, 'time', 'PPO', 3)}.zip"
+    _check_outputs(path, "PPO", 1000)
+    model = PPO.load(path, device="cpu")
+    action, _ = model.predict(np.zeros(model.observation_space.shape, np.float32),
+                              deterministic=True)  # fmt: skip
+    assert model.action_space.contains(action)
+
+
+@pytest.mark.slow
+def test_train_sac_smoke_through_the_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                         monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
+    import baselines.hyperparameters as table
+
+    entry = table.HYPERPARAMETERS[(MANIPULATOR, "time", "SAC")]
+    monkeypatch.setitem(entry, "algo_kwargs", {**entry["algo_kwargs"], "learning_starts": 200,
+                                               "batch_size": 32, "gradient_steps": 1,
+                                               "buffer_size": 2000, **TINY})  # fmt: skip
+    parser = argparse.ArgumentParser()
+    add_train_parser(parser.add_subparsers())
+    args = parser.parse_args(["train", MANIPULATOR, "sac", "--seed", "3", "--timesteps",
+                              "1000", "--num-envs", "1", "--eval-episodes", "1",
+                              "--output", str(tmp_path), "--no-progress-bar"])  # fmt: skip
+    assert args.handler(args) == 0
+    out = capsys.readouterr().out
+    assert "trained SAC" in out and "evaluation (1 episodes" in out
+    config = _check_outputs(tmp_path / f"{run_name(MANIPULATOR, 'time', 'SAC', 3)}.zip",
+                            "SAC", 1000)  # fmt: skip
+    assert config["num_envs"] == 1 and config["num_episodes"] == 2
+
+
+def test_cli_rejects_unknown_combinations() -> None:
+    parser = argparse.ArgumentParser()
+    add_train_parser(parser.add_subparsers())
+    with pytest.raises(SystemExit):
+        parser.parse_args(["train", "mdi_envs/BouncingBall-v0", "PPO"])
+    args = parser.parse_args(["train", MANIPULATOR, "ppo"])
+    assert args.algo == "PPO" and args.task is None and args.seed is None
+
+
+def test_plot_training_handles_empty_and_full_logs(tmp_path: Path) -> None:
+    plot_training([], tmp_path / "empty.png")
+    rows = [(100 * k, -float(k), 50, k % 2 == 0, 1.0, 2.0) for k in range(150)]
+    plot_training(rows, tmp_path / "full.png", title="t")
+    assert (tmp_path / "empty.png").stat().st_size > 0 and (tmp_path / "full.png").exists()
