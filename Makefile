@@ -30,7 +30,7 @@ bench: $(VENV)/.installed-bench
 	$(BIN)/python -m benchmarks.envs --output results/bench
 
 lint: $(VENV)/.installed-dev
-	$(BIN)/ruff check mdi_envs tests benchmarks
+	$(BIN)/ruff check mdi_envs optimal baselines tests benchmarks
 	$(BIN)/mypy mdi_envs
 
 clean:

@@ -81,7 +81,7 @@ class MoreauJeanVecEnv(VecEnv):
         """Reset every copy (with the seeds and options set by ``seed``/``set_options``)."""
         seeds = None if all(s is None for s in self._seeds) else list(self._seeds)
         options = self._options[0] if self._options and self._options[0] else None
-        obs, _ = self.venv.reset(seed=seeds, options=options)
+        obs, _ = self.venv.reset(seed=seeds, options=options)  # type: ignore[arg-type]
         self.reset_infos = [{} for _ in range(self.num_envs)]
         self._reset_seeds()
         self._reset_options()
@@ -134,8 +134,8 @@ class MoreauJeanVecEnv(VecEnv):
                 for i, value in enumerate(listed):
                     infos[i][key] = value
             else:
-                for i in np.flatnonzero(mask):
-                    infos[i][key] = listed[i]
+                for j in np.flatnonzero(mask).tolist():
+                    infos[j][key] = listed[j]
         return infos
 
     def close(self) -> None:

@@ -65,6 +65,15 @@ def load_actions(path: Path) -> np.ndarray:
     return np.asarray(actions, dtype=np.float32).reshape(len(actions), -1)
 
 
+def _sampler(space: gym.Space[Any]) -> Policy:
+    """The random policy: a sample of ``space`` whatever the observation."""
+
+    def act(_obs: Any) -> Any:
+        return space.sample()
+
+    return act
+
+
 def rollout(
     env_id: str,
     policy: Policy | str = "random",
@@ -88,28 +97,27 @@ def rollout(
         warnings.simplefilter("ignore")
         env = gym.make(env_id, render_mode="rgb_array" if record else render_mode, **env_kwargs)
     env.action_space.seed(seed)
+    act: Policy
     if policy == "random":
-
-        def act(_obs: Any) -> Any:
-            return env.action_space.sample()
-
+        act = _sampler(env.action_space)
     elif callable(policy):
         act = policy
     else:
         raise ValueError(f"policy must be 'random' or a callable, got {policy!r}")
     obs, _ = env.reset(seed=seed)
     result = Rollout(env_id)
-    coordinates = [env.unwrapped.q]
+    model: Any = env.unwrapped  # a MoreauJeanEnv
+    coordinates = [model.q]
     if record:
-        result.frames.append(env.render())
+        result.frames.append(np.asarray(env.render()))
     while max_steps is None or result.num_steps < max_steps:
         obs, reward, terminated, truncated, info = env.step(act(obs))
         result.num_steps += 1
         result.total_reward += float(reward)
         result.last_info = info
-        coordinates.append(env.unwrapped.q)
+        coordinates.append(model.q)
         if record:
-            result.frames.append(env.render())
+            result.frames.append(np.asarray(env.render()))
         if terminated or truncated:
             result.terminated, result.truncated = bool(terminated), bool(truncated)
             break

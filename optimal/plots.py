@@ -36,7 +36,10 @@ def _manipulator(reference: Reference, folder: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
     t, q, u = reference.time, reference.q, reference.u
-    engaged = np.isinf(reference.brake_bound[:, 0])
+    brake = reference.brake_bound
+    if brake is None:
+        raise ValueError(f"{reference.name} has no brake: not a manipulator reference")
+    engaged = np.isinf(brake[:, 0])
     fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     axes[0].plot(t, u[:, 0], label="alpha'")
     axes[0].plot(t, u[:, 1], label="beta'")

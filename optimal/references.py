@@ -87,7 +87,7 @@ def save_reference(reference: Reference, directory: Path | str = REFERENCE_DIR) 
     """Write ``NAME.npz`` and ``NAME.json`` into ``directory``; returns the JSON path."""
     folder = Path(directory)
     folder.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(folder / f"{reference.name}.npz", **reference.arrays)
+    np.savez_compressed(folder / f"{reference.name}.npz", **reference.arrays)  # type: ignore[arg-type]
     path = folder / f"{reference.name}.json"
     path.write_text(json.dumps(reference.metadata, indent=1, sort_keys=True) + "\n")
     return path

@@ -149,7 +149,8 @@ def replay_in_env(reference: Reference) -> tuple[FloatArray, dict[str, Any]]:
         _, _, terminated, truncated, info = env.step(action)
         if terminated or truncated:
             break
-    return env.unwrapped.q, info
+    model: Any = env.unwrapped  # a MoreauJeanEnv
+    return model.q, info
 
 
 __all__ = ["ReplayReport", "env_actions", "env_options", "goal_errors", "replay", "replay_in_env"]

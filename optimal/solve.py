@@ -172,7 +172,7 @@ def _commit() -> str:
 def _casadi_version() -> str:
     import casadi
 
-    return str(casadi.__version__)
+    return str(getattr(casadi, "__version__", "unknown"))
 
 
 __all__ = ["BRAKE_VELOCITY_TOLERANCE", "ENV_VERSION", "SLIP_TOLERANCE", "solve_problem"]
