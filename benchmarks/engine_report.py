@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import format_us, markdown_table, plt
+from benchmarks.report import format_us, load_average_text, markdown_table, plt
 
 MODEL_TITLES = {
     "ball": "bouncing ball",
@@ -201,10 +201,7 @@ def markdown_report(record: Mapping[str, Any]) -> str:
     """All result tables of one run, as printed on stdout and pasted into the README."""
     machine = record["machine"]
     versions = machine["versions"]
-    start = machine.get("load_average_at_start") or []
-    end = machine.get("load_average_at_end") or []
-    load_text = (f"load average (1/5/15 min) {'/'.join(f'{x:.2f}' for x in start)} at start, "
-                 f"{'/'.join(f'{x:.2f}' for x in end)} at end")
+    load_text = load_average_text(machine)
     lines = [
         f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
         f"numpy {versions.get('numpy')}, numba {versions.get('numba')}, mujoco "

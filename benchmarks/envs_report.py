@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import format_ratio, markdown_table, plt
+from benchmarks.report import format_ratio, load_average_text, markdown_table, plt
 
 SHORT_NAMES = {
     "mdi_envs/BlockableManipulator-v0": "BlockableManipulator",
@@ -106,10 +106,7 @@ def markdown_report(record: Mapping[str, Any]) -> str:
     """All result tables of one run, as printed on stdout and pasted into the README."""
     machine = record["machine"]
     versions = machine["versions"]
-    start = machine.get("load_average_at_start") or []
-    end = machine.get("load_average_at_end") or []
-    load_text = (f"load average (1/5/15 min) {'/'.join(f'{x:.2f}' for x in start)} at start, "
-                 f"{'/'.join(f'{x:.2f}' for x in end)} at end")
+    load_text = load_average_text(machine)
     pinning = record["pinning"]
     pin_text = (f"pinned to CPU {pinning['cpus']}" if pinning.get("pinned")
                 else f"not pinned (CPUs {pinning.get('cpus')})")

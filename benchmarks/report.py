@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -88,6 +88,14 @@ def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, An
             }
         )
     return rows
+
+
+def load_average_text(machine: Mapping[str, Any]) -> str:
+    """The machine record's load averages at start and end of a run, as one phrase."""
+    start = machine.get("load_average_at_start") or []
+    end = machine.get("load_average_at_end") or []
+    return (f"load average (1/5/15 min) {'/'.join(f'{x:.2f}' for x in start)} at start, "
+            f"{'/'.join(f'{x:.2f}' for x in end)} at end")
 
 
 def markdown_table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from numba import njit
+
 
 @dataclass(frozen=True)
 class ManipulatorTask:
@@ -80,8 +82,9 @@ MANIPULATOR_TASK = ManipulatorTask()
 DIFF_DRIVE_TASK = DiffDriveTask()
 
 
+@njit(cache=True)
 def wrap_angle(angle: float) -> float:
-    """``angle`` [rad] mapped to [-pi, pi)."""
+    """``angle`` [rad] mapped to [-pi, pi) (compiled: also callable from the env kernels)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 

@@ -20,7 +20,7 @@ from mdi_envs.envs.base import (
 )
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulator
 from mdi_envs.mechanics.parameters import require_positive
-from mdi_envs.tasks import MANIPULATOR_TASK
+from mdi_envs.tasks import MANIPULATOR_TASK, wrap_angle
 
 VELOCITY_WEIGHT = 0.3  # [s] weight of the speeds in the goal distance (rad/s -> rad)
 
@@ -85,15 +85,15 @@ class BlockableManipulatorTask(MoreauJeanTask):
     @staticmethod
     def distance_one(q: Any, u: Any, c: Any) -> float:
         """sqrt(e_a^2 + e_b^2 + w^2 (a'^2 + b'^2)), wrapped angle errors e, w = 0.3 s."""
-        e0 = (q[0] - c[0] + math.pi) % (2.0 * math.pi) - math.pi
-        e1 = (q[1] - c[1] + math.pi) % (2.0 * math.pi) - math.pi
+        e0 = wrap_angle(q[0] - c[0])
+        e1 = wrap_angle(q[1] - c[1])
         return math.sqrt(e0 * e0 + e1 * e1 + c[4] * c[4] * (u[0] * u[0] + u[1] * u[1]))
 
     @staticmethod
     def success_one(q: Any, u: Any, c: Any) -> bool:
         """Both wrapped angle errors <= angle tol and both speeds <= speed tol."""
-        e0 = (q[0] - c[0] + math.pi) % (2.0 * math.pi) - math.pi
-        e1 = (q[1] - c[1] + math.pi) % (2.0 * math.pi) - math.pi
+        e0 = wrap_angle(q[0] - c[0])
+        e1 = wrap_angle(q[1] - c[1])
         return (max(abs(e0), abs(e1)) <= c[2]) and (max(abs(u[0]), abs(u[1])) <= c[3])
 
     INFO_KEYS = ("brake_engaged", "brake_impulse")

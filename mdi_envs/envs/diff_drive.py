@@ -17,7 +17,7 @@ from mdi_envs.envs.base import BatchState, MoreauJeanEnv, MoreauJeanTask, Moreau
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
 from mdi_envs.mechanics.parameters import require_positive
 from mdi_envs.stepping._spatial_kernel import INFO_LIFTED_CONTACTS, INFO_MODE, INFO_RESIDUAL
-from mdi_envs.tasks import DIFF_DRIVE_TASK
+from mdi_envs.tasks import DIFF_DRIVE_TASK, wrap_angle
 
 HEADING_WEIGHT = 0.5  # [m/rad] weight of the heading error in the goal distance
 VELOCITY_WEIGHT = 0.5  # [s] weight of the chassis speed in the goal distance
@@ -98,7 +98,7 @@ class DiffDriveRobotTask(MoreauJeanTask):
     def distance_one(q: Any, u: Any, c: Any) -> float:
         """sqrt(|dp|^2 + (w_h e_phi)^2 + (w_v |v|)^2 + (w_r phi')^2), e_phi wrapped."""
         dx, dy = q[0] - c[0], q[1] - c[1]
-        e_phi = (q[2] - c[2] + math.pi) % (2.0 * math.pi) - math.pi
+        e_phi = wrap_angle(q[2] - c[2])
         return math.sqrt(dx * dx + dy * dy + (c[7] * e_phi) ** 2
                          + c[8] * c[8] * (u[0] * u[0] + u[1] * u[1]) + (c[9] * u[2]) ** 2)
 
@@ -106,7 +106,7 @@ class DiffDriveRobotTask(MoreauJeanTask):
     def success_one(q: Any, u: Any, c: Any) -> bool:
         """Position, heading, speed and yaw rate within the task's tolerances."""
         dx, dy = q[0] - c[0], q[1] - c[1]
-        e_phi = (q[2] - c[2] + math.pi) % (2.0 * math.pi) - math.pi
+        e_phi = wrap_angle(q[2] - c[2])
         return (math.sqrt(dx * dx + dy * dy) <= c[3] and abs(e_phi) <= c[4]
                 and math.sqrt(u[0] * u[0] + u[1] * u[1]) <= c[5] and abs(u[2]) <= c[6])
 
