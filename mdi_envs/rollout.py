@@ -30,6 +30,7 @@ class Rollout:
         terminated, truncated: how it ended. last_info: the last step's ``info``.
         frames: rgb_array frames (H, W, 3) uint8 if recorded (the reset frame first).
         q: (num_steps + 1, n) coordinates along the episode.
+        infos: the ``info`` dict of every step (num_steps entries).
     """
 
     env_id: str
@@ -40,6 +41,7 @@ class Rollout:
     last_info: dict[str, Any] = field(default_factory=dict)
     frames: list[np.ndarray] = field(default_factory=list)
     q: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    infos: list[dict[str, Any]] = field(default_factory=list)
 
 
 def open_loop_policy(actions: np.ndarray) -> Policy:
@@ -115,6 +117,7 @@ def rollout(
         result.num_steps += 1
         result.total_reward += float(reward)
         result.last_info = info
+        result.infos.append(info)
         coordinates.append(model.q)
         if record:
             result.frames.append(np.asarray(env.render()))
