@@ -1,8 +1,8 @@
 """The ``mdi-envs`` command line: one tool for the project's main jobs.
 
 Subcommands: ``demo`` (solvers and the manipulator), ``solve`` (one Siconos file),
-``simulate`` (one episode of an environment, optionally saved as GIF/MP4) and ``optimize``
-(an optimal-control reference). Training and the benchmark suite arrive with their issues.
+``simulate`` (one episode of an environment, optionally saved as GIF/MP4), ``optimize``
+(an optimal-control reference), ``train`` (an SB3 baseline) and ``bench`` (the benchmark suite).
 Each subcommand imports what it needs inside its handler.
 """
 
@@ -83,10 +83,12 @@ def _build_parser() -> argparse.ArgumentParser:
     simulate.set_defaults(handler=_run_simulate)
 
     from baselines.cli import add_train_parser
+    from benchmarks.cli import add_bench_parser
     from optimal.cli import add_optimize_parser
 
     add_optimize_parser(commands)
     add_train_parser(commands)
+    add_bench_parser(commands)
     return parser
 
 

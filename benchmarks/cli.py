@@ -1,0 +1,90 @@
+"""``mdi-envs bench [NAME ...] [--quick]``: the benchmark suite, one command.
+
+Each NAME runs one benchmark module's ``main`` with ``--output`` (and ``--quick``) and writes its
+JSON and PNG files there; ``headline`` then collects the headline numbers of whatever results the
+folder holds into ``headline.json`` and ``headline.md``. Without NAME every benchmark runs, in
+the order of ``BENCHMARKS``. The exit code is non-zero when a benchmark crashes or a stress case
+fails (``--quick`` runs inside ``make test`` and so checks the stress criteria on every commit).
+
+Wiring (in ``mdi_envs/cli.py``): ``add_bench_parser(commands)``; its handler is ``run_bench``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+BENCHMARKS = {
+    "solvers": ("benchmarks.solvers", "LCP methods: work vs size, Lemke vs QuantEcon"),
+    "engine": ("benchmarks.engine", "stepper µs per step (single, batched) vs MuJoCo, the "
+               "shortcut ablation (on vs off: equality, speedup), brake stop vs MuJoCo"),
+    "envs": ("benchmarks.envs", "env.step via gym.make and vector-env throughput vs "
+             "Acrobot-v1 and MuJoCo"),
+    "precision": ("benchmarks.work_precision", "error vs wall time per scene vs closed form, "
+                  "the event-driven reference and MuJoCo"),
+    "stress": ("benchmarks.stress", "numerical stress cases with pass/fail criteria"),
+}
+"""NAME -> (module with ``main(argv)``, what it measures)."""
+
+DEFAULT_OUTPUT = Path("benchmarks/results")
+"""Where the full run writes (committed); ``--quick`` writes into its ``quick/`` subfolder."""
+
+
+def add_bench_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``bench`` subcommand to an argparse subparsers object; returns its parser."""
+    listing = "; ".join(f"{name}: {text}" for name, (_, text) in BENCHMARKS.items())
+    parser = subparsers.add_parser(
+        "bench",
+        help="run the benchmark suite (or some of it) and write JSON + PNG results",
+        description=f"Benchmarks: {listing}. Writes into --output (default "
+        f"{DEFAULT_OUTPUT}, --quick: {DEFAULT_OUTPUT / 'quick'}) and a headline table of all "
+        "results found there. Needs the bench extra (pip install 'mdi-envs[bench]').",
+    )
+    parser.add_argument("names", nargs="*", metavar="NAME",
+                        help=f"benchmarks to run (default: all of {', '.join(BENCHMARKS)})")
+    parser.add_argument("--quick", action="store_true",
+                        help="small grids and budgets (about 2-3 min for all; used by make test)")
+    parser.add_argument("--output", type=Path, default=None, help="results folder")
+    parser.set_defaults(handler=run_bench)
+    return parser
+
+
+def run_bench(args: argparse.Namespace) -> int:
+    """Handler of ``bench``: runs the chosen benchmarks, then the headline table; exit code."""
+    from benchmarks.headline import write_headline
+
+    names = list(args.names) or list(BENCHMARKS)
+    unknown = [name for name in names if name not in BENCHMARKS]
+    if unknown:
+        raise SystemExit(f"bench: unknown benchmark {', '.join(unknown)}; "
+                         f"choose from {', '.join(BENCHMARKS)}")  # fmt: skip
+    output = args.output or (DEFAULT_OUTPUT / "quick" if args.quick else DEFAULT_OUTPUT)
+    output.mkdir(parents=True, exist_ok=True)
+    failures: list[str] = []
+    for name in names:
+        module_name = BENCHMARKS[name][0]
+        start = time.perf_counter()
+        print(f"== bench {name} ({module_name}){' --quick' if args.quick else ''}", flush=True)
+        argv = ["--output", str(output)] + (["--quick"] if args.quick else [])
+        try:
+            code = importlib.import_module(module_name).main(argv)
+        except Exception:  # a crash of one benchmark is reported, the others still run
+            traceback.print_exc()
+            code = 1
+        if code:
+            failures.append(name)
+        print(f"== bench {name}: {'FAILED' if code else 'ok'} in "
+              f"{time.perf_counter() - start:.0f} s", flush=True)  # fmt: skip
+    print(write_headline(output))
+    if failures:
+        print(f"bench: failed: {', '.join(failures)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+__all__ = ["BENCHMARKS", "DEFAULT_OUTPUT", "add_bench_parser", "run_bench"]
