@@ -6,7 +6,9 @@ Example: ``mdi-envs train mdi_envs/DiffDriveRobot-v0 PPO --task effort --output
 results/baselines`` (3 x 10^6 steps; the budget and settings are in
 ``baselines/hyperparameters.py``) shows SB3's progress bar on a terminal and writes the model
 zip, its JSON config, the episode CSV, the training-curve PNG and TensorBoard logs into
-``--output``. ``--timesteps 20000`` gives a run of a minute or two.
+``--output``. ``--timesteps 20000`` gives a run of a minute or two. ``mdi-envs train
+mdi_envs/BlockableManipulator-v0 HybridPPO`` trains ``baselines.hybrid_ppo.HybridPPO`` on the
+manipulator's native hybrid action space (algorithm names are case-insensitive).
 """
 
 from __future__ import annotations
@@ -19,11 +21,11 @@ from typing import Any
 
 def add_train_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Add the ``train`` subcommand to an argparse subparsers object; returns its parser."""
-    from baselines.hyperparameters import ALGORITHMS, DEFAULT_TASKS
+    from baselines.hyperparameters import ALGORITHMS, DEFAULT_TASKS, canonical_algorithm
 
     parser = subparsers.add_parser(
         "train",
-        help="train an SB3 baseline (PPO or SAC) on a mission environment",
+        help="train an SB3 baseline (PPO, SAC or HybridPPO) on a mission environment",
         description="Train ALGO on ENV_ID through the batched vector env with the settings of "
         "baselines/hyperparameters.py (seed, budget and copies overridable), then evaluate it "
         "and save STEM.zip, STEM.json (exact config, versions, commit, scores), "
@@ -31,7 +33,9 @@ def add_train_parser(subparsers: Any) -> argparse.ArgumentParser:
         "(pip install 'mdi-envs[rl]').",
     )
     parser.add_argument("env_id", choices=sorted(DEFAULT_TASKS), help="the environment")
-    parser.add_argument("algo", type=str.upper, choices=ALGORITHMS, help="the algorithm")
+    parser.add_argument("algo", type=canonical_algorithm, choices=ALGORITHMS,
+                        help="the algorithm (case-insensitive; HybridPPO: the manipulator's "
+                        "hybrid brake x torque action space)")
     parser.add_argument("--task", choices=("time", "effort"), default=None,
                         help="objective (effort: diff drive only; default time)")
     parser.add_argument("--seed", type=int, default=None, help="seed (default: the table's)")

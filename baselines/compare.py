@@ -139,19 +139,10 @@ def shipped_policies(env_id: str, task: str, directory: Path = TRAINED_DIR) -> l
     return configs
 
 
-def algorithm_class(name: str) -> Any:
-    """The SB3-compatible class of an algorithm name ("PPO", "SAC", "HybridPPO")."""
-    if name.lower() == "hybridppo":
-        from baselines.hybrid_ppo import HybridPPO
-
-        return HybridPPO
-    import stable_baselines3
-
-    return getattr(stable_baselines3, name.upper())
-
-
 def load_policy(config_path: Path) -> tuple[Callable[[], Policy], dict[str, Any], dict[str, Any]]:
     """A trained policy (deterministic ``predict``), its ``gym.make`` arguments and its config."""
+    from baselines.train import algorithm_class
+
     config = json.loads(Path(config_path).read_text())
     model = algorithm_class(config["algo"]).load(Path(config_path).with_suffix(".zip"),
                                                  device="cpu")  # fmt: skip
@@ -305,7 +296,7 @@ def write_comparison(comparison: dict[str, Any], output: Path) -> list[Path]:
 
 
 __all__ = [
-    "OPTIMAL", "REFERENCE_NAMES", "TASKS", "TRAINED_DIR", "Episode", "algorithm_class",
+    "OPTIMAL", "REFERENCE_NAMES", "TASKS", "TRAINED_DIR", "Episode",
     "compare", "comparison_record", "evaluate_controller", "load_policy", "markdown_table",
     "play", "reference_controller", "reference_effort", "shipped_policies", "summarize",
     "write_comparison",

@@ -1,20 +1,24 @@
 """The one table of baseline settings, keyed by (env id, task, algorithm).
 
 Each entry holds the SB3 constructor arguments, the number of batched copies, the training
-budget, the seed and the environment arguments. Choices shared by every entry:
+budget, the seed and the environment arguments. Algorithms: SB3's PPO and SAC on the default
+flattened Box action spaces, and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a categorical
+brake x Gaussian torque policy) on the manipulator's native ``action_mode="hybrid"`` space
+``Tuple(Discrete(2), Box(-1, 1, (1,)))``. Choices shared by every entry:
 
-- ``gamma = 0.99`` for both algorithms, passed to the env as ``shaping_discount`` (the shaping
+- ``gamma = 0.99`` for every algorithm, passed to the env as ``shaping_discount`` (the shaping
   term gamma Phi(s') - Phi(s) then leaves the optimal policy unchanged; ``train`` sets it).
 - PPO with many copies (64): the batched env steps them in one compiled call, so a rollout of
   64 x 256 = 16384 steps costs about as much as a few hundred single-env steps; minibatches
   of 2048, 10 epochs, GAE lambda 0.95, clip 0.2, no entropy bonus, 2 x 64 tanh MLPs (SB3's
   defaults otherwise, as in rl-zoo's continuous-control settings).
+- HybridPPO: exactly the PPO settings (no per-algorithm tuning), only the action space differs.
 - SAC with fewer copies (8) and ``gradient_steps = num_envs`` (one gradient step per env
   transition, SAC's usual replay ratio), 10^6 buffer, batch 256, 2 x 256 ReLU MLPs, automatic
   entropy tuning, 10^4 random warm-up steps.
-- Budgets: PPO 3 x 10^6 steps, SAC 3 x 10^5 (episodes: manipulator up to 500 steps of 0.02 s,
-  the optimum takes about 228; diff drive "time" up to 200 steps of 0.05 s, "effort" exactly
-  81). Untuned starting points: the shipped results say how far they get.
+- Budgets: PPO and HybridPPO 3 x 10^6 steps, SAC 3 x 10^5 (episodes: manipulator up to 500
+  steps of 0.02 s, the optimum takes about 228; diff drive "time" up to 200 steps of 0.05 s,
+  "effort" exactly 81). Untuned starting points: the shipped results say how far they get.
 - Seed 0 everywhere; ``train(..., seed=...)`` overrides it.
 """
 
@@ -25,7 +29,15 @@ from typing import Any
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
-ALGORITHMS = ("PPO", "SAC")
+ALGORITHMS = ("PPO", "SAC", "HybridPPO")
+"""The algorithm names, canonical spelling (lookups are case-insensitive)."""
+ALGORITHM_CLASSES = {
+    "PPO": "stable_baselines3:PPO",
+    "SAC": "stable_baselines3:SAC",
+    "HybridPPO": "baselines.hybrid_ppo:HybridPPO",
+}
+"""Algorithm name -> "module:class" of its SB3-compatible class (imported on use, see
+``baselines.train.algorithm_class``; this module imports no SB3)."""
 
 _PPO: dict[str, Any] = {
     "num_envs": 64,
@@ -57,6 +69,7 @@ def _entry(base: dict[str, Any], env_kwargs: dict[str, Any]) -> dict[str, Any]:
 HYPERPARAMETERS: dict[tuple[str, str, str], dict[str, Any]] = {
     (MANIPULATOR, "time", "PPO"): _entry(_PPO, {}),
     (MANIPULATOR, "time", "SAC"): _entry(_SAC, {}),
+    (MANIPULATOR, "time", "HybridPPO"): _entry(_PPO, {"action_mode": "hybrid"}),
     (DIFF_DRIVE, "time", "PPO"): _entry(_PPO, {"task": "time"}),
     (DIFF_DRIVE, "time", "SAC"): _entry(_SAC, {"task": "time"}),
     (DIFF_DRIVE, "effort", "PPO"): _entry(_PPO, {"task": "effort"}),
@@ -70,19 +83,27 @@ DEFAULT_TASKS = {MANIPULATOR: "time", DIFF_DRIVE: "time"}
 """The task used when none is given (the manipulator has only "time")."""
 
 
+def canonical_algorithm(name: str) -> str:
+    """The ``ALGORITHMS`` spelling of ``name`` ("ppo" -> "PPO", "hybridppo" -> "HybridPPO").
+
+    An unknown name is returned unchanged (the caller's lookup then reports it).
+    """
+    return {algo.lower(): algo for algo in ALGORITHMS}.get(name.lower(), name)
+
+
 def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict[str, Any]:
     """A deep copy of the table entry, with ``env_kwargs["shaping_discount"] = gamma``.
 
     Args:
         env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
-        algo: "PPO" or "SAC" (case-insensitive).
+        algo: "PPO", "SAC" or "HybridPPO" (case-insensitive; HybridPPO: manipulator only).
         task: "time" or "effort" (diff drive only); default ``DEFAULT_TASKS[env_id]``.
 
     Raises:
         KeyError: no entry for this combination (the message lists the known keys).
     """
     task = DEFAULT_TASKS.get(env_id) if task is None else task
-    key = (env_id, str(task), algo.upper())
+    key = (env_id, str(task), canonical_algorithm(algo))
     if key not in HYPERPARAMETERS:
         known = ", ".join(" ".join(k) for k in HYPERPARAMETERS)
         raise KeyError(f"no hyperparameters for {' '.join(map(str, key))}; known: {known}")
@@ -91,4 +112,7 @@ def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict
     return entry
 
 
-__all__ = ["ALGORITHMS", "DEFAULT_TASKS", "HYPERPARAMETERS", "get_hyperparameters"]
+__all__ = [
+    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_TASKS", "HYPERPARAMETERS", "canonical_algorithm",
+    "get_hyperparameters",
+]

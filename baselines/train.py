@@ -6,7 +6,8 @@ checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched 
 (``baselines.hyperparameters``), logs to TensorBoard, evaluates the deterministic policy with
 ``evaluate_policy`` on ``gym.make`` copies, and writes into ``output``:
 
-- ``STEM.zip``: the SB3 model (``PPO.load``/``SAC.load``);
+- ``STEM.zip``: the SB3 model (``PPO.load``/``SAC.load``/``HybridPPO.load``, the class from
+  ``algorithm_class(config["algo"])``);
 - ``STEM.json``: env id, task, algorithm, seed, the exact SB3 and env arguments, budget,
   package versions, git commit, wall time, training and evaluation scores;
 - ``STEM_episodes.csv``: one row per finished training episode (timesteps, return, length,
@@ -15,12 +16,17 @@ checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched 
 - ``tensorboard/STEM_1/``: SB3's TensorBoard logs (``tensorboard --logdir OUTPUT/tensorboard``);
 
 with STEM = ``{env name}_{task}_{algo}_seed{seed}``, e.g. ``DiffDriveRobot-v0_effort_ppo_seed0``.
+
+The algorithm names and their classes are in ``baselines.hyperparameters`` (``ALGORITHMS``,
+``ALGORITHM_CLASSES``): SB3's PPO and SAC, and ``HybridPPO`` (``baselines.hybrid_ppo``) on the
+manipulator's hybrid action space.
 """
 
 from __future__ import annotations
 
 import copy
 import csv
+import importlib
 import json
 import platform
 import subprocess
@@ -35,7 +41,7 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 import mdi_envs
-from baselines.hyperparameters import get_hyperparameters
+from baselines.hyperparameters import ALGORITHM_CLASSES, canonical_algorithm, get_hyperparameters
 
 EPISODE_COLUMNS = ("timesteps", "return", "length", "is_success", "elapsed_time", "effort")
 """Columns of ``STEM_episodes.csv`` (steps, -, steps, bool, s, N^2 m^2 s)."""
@@ -68,8 +74,24 @@ def run_name(env_id: str, task: str, algo: str, seed: int) -> str:
     return f"{env_id.split('/')[-1]}_{task}_{algo.lower()}_seed{seed}"
 
 
+def algorithm_class(algo: str) -> Any:
+    """The SB3-compatible class of an algorithm name (case-insensitive), imported on use.
+
+    Raises:
+        KeyError: unknown name (the message lists ``ALGORITHM_CLASSES``).
+    """
+    name = canonical_algorithm(algo)
+    if name not in ALGORITHM_CLASSES:
+        raise KeyError(f"unknown algorithm {algo!r}; known: {', '.join(ALGORITHM_CLASSES)}")
+    module, _, attribute = ALGORITHM_CLASSES[name].partition(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
 def check_single_env(env_id: str, env_kwargs: dict[str, Any]) -> None:
     """Gymnasium's and SB3's ``check_env`` on ``gym.make(env_id, **env_kwargs)``.
+
+    SB3's checker is skipped for a Tuple action space (``action_mode="hybrid"``): SB3 does not
+    support one (its NaN check cannot even batch a Tuple sample); ``HybridPPO`` adapts it.
 
     Raises:
         AssertionError: the env breaks the API (raised by the checkers).
@@ -81,7 +103,8 @@ def check_single_env(env_id: str, env_kwargs: dict[str, Any]) -> None:
         warnings.simplefilter("ignore")
         env = gym.make(env_id, **env_kwargs)
         gym_check_env(env.unwrapped, skip_render_check=True)
-        sb3_check_env(env, warn=False)
+        if not isinstance(env.action_space, gym.spaces.Tuple):
+            sb3_check_env(env, warn=False)
     env.close()
 
 
@@ -98,12 +121,13 @@ def train(
     eval_episodes: int = 10,
     progress_bar: bool | None = None,
     verbose: int = 0,
+    torch_threads: int = 1,
 ) -> Path:
     """Train ``algo`` on ``env_id`` with the table's settings; returns the model's zip path.
 
     Args:
         env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
-        algo: "PPO" or "SAC".
+        algo: "PPO", "SAC" or "HybridPPO" (case-insensitive; ``ALGORITHMS``).
         task: "time" or "effort" (diff drive); default the env's "time".
         seed: the run's seed (SB3's ``seed``: torch, the action noise and env copy i's
             start states from seed + i); default the table's.
@@ -114,15 +138,18 @@ def train(
         eval_episodes: deterministic evaluation episodes on ``gym.make`` after training.
         progress_bar: SB3's progress bar (tqdm + rich); default when stderr is a terminal.
         verbose: SB3's verbosity.
+        torch_threads: torch's intra-op threads for the run. One by default: the networks are
+            tiny (64-256 units), so more threads only add synchronisation, and on a busy
+            2-core machine two threads made a PPO run about 20x slower.
     """
-    import stable_baselines3
     import torch
     from stable_baselines3.common.vec_env import VecMonitor
 
     from baselines.vec_env import make_vec_env
 
+    torch.set_num_threads(int(torch_threads))
     entry = get_hyperparameters(env_id, algo, task)
-    algo = algo.upper()
+    algo = canonical_algorithm(algo)
     task = entry["env_kwargs"].get("task", "time")
     seed = entry["seed"] if seed is None else int(seed)
     total_timesteps = entry["total_timesteps"] if total_timesteps is None else total_timesteps
@@ -137,7 +164,7 @@ def train(
 
     check_single_env(env_id, env_kwargs)
     venv = VecMonitor(make_vec_env(env_id, num_envs, **env_kwargs))
-    model_class = getattr(stable_baselines3, algo)
+    model_class = algorithm_class(algo)
     model = model_class("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose,
                         tensorboard_log=str(output / "tensorboard"),
                         **copy.deepcopy(algo_kwargs))  # fmt: skip
@@ -279,4 +306,7 @@ def git_commit() -> str | None:
     return commit + ("+dirty" if dirty else "")
 
 
-__all__ = ["EpisodeLog", "check_single_env", "evaluate", "plot_training", "run_name", "train"]
+__all__ = [
+    "EpisodeLog", "algorithm_class", "check_single_env", "evaluate", "plot_training", "run_name",
+    "train",
+]

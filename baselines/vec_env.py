@@ -25,6 +25,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
 from stable_baselines3.common.vec_env.base_vec_env import (
     VecEnv,
     VecEnvIndices,
@@ -87,8 +88,16 @@ class MoreauJeanVecEnv(VecEnv):
         self._reset_options()
         return np.asarray(obs).copy()
 
-    def step_async(self, actions: np.ndarray) -> None:
-        """Store the (N, action_dim) actions for ``step_wait``."""
+    def step_async(self, actions: Any) -> None:
+        """Store the actions for ``step_wait``: (N, action_dim) for a Box action space.
+
+        For a Tuple action space (``action_mode="hybrid"``) either a list of N per-copy tuples
+        (SB3's layout, as ``DummyVecEnv`` takes; stacked here) or one tuple of batched
+        components (Gymnasium's ``batch_space`` layout, e.g. (choices (N,), torques (N, m))).
+        """
+        if isinstance(self.action_space, spaces.Tuple) and not isinstance(actions, tuple):
+            actions = tuple(np.stack([np.asarray(action[j]) for action in actions])
+                            for j in range(len(self.action_space.spaces)))  # fmt: skip
         self._actions = actions
 
     def step_wait(self) -> VecEnvStepReturn:

@@ -73,7 +73,8 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     simulate.add_argument("env_id", help="e.g. mdi_envs/BlockableManipulator-v0")
     simulate.add_argument("--policy", default="random", help="see above (default: random)")
-    simulate.add_argument("--algo", default="PPO", help="SB3 algorithm of a .zip policy")
+    simulate.add_argument("--algo", default="PPO",
+                          help="algorithm of a .zip policy (PPO, SAC, HybridPPO)")
     simulate.add_argument("--seed", type=int, default=0, help="reset seed")
     simulate.add_argument("--steps", type=int, default=None, help="stop after this many steps")
     simulate.add_argument("--save", type=Path, default=None, help="write a .gif or .mp4")
@@ -119,9 +120,9 @@ def _run_simulate(args: argparse.Namespace) -> int:
         env_kwargs = {**env_options(reference), **env_kwargs}
         policy = open_loop_policy(env_actions(reference))
     elif policy.endswith(".zip"):
-        import stable_baselines3
+        from baselines.train import algorithm_class
 
-        model = getattr(stable_baselines3, args.algo).load(policy, device="cpu")
+        model = algorithm_class(args.algo).load(policy, device="cpu")
         policy = lambda obs: model.predict(obs, deterministic=True)[0]  # noqa: E731
     elif policy != "random":
         policy = open_loop_policy(load_actions(Path(policy)))

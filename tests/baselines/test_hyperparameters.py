@@ -6,13 +6,19 @@ import gymnasium as gym
 import pytest
 
 import mdi_envs  # noqa: F401 - registers the ids
-from baselines.hyperparameters import HYPERPARAMETERS, get_hyperparameters
+from baselines.hyperparameters import (
+    ALGORITHM_CLASSES,
+    ALGORITHMS,
+    HYPERPARAMETERS,
+    canonical_algorithm,
+    get_hyperparameters,
+)
 
 
 def test_table_covers_both_envs_tasks_and_algorithms() -> None:
-    assert len(HYPERPARAMETERS) == 6
+    assert len(HYPERPARAMETERS) == 7 and set(ALGORITHM_CLASSES) == set(ALGORITHMS)
     for (env_id, task, algo), entry in HYPERPARAMETERS.items():
-        assert env_id in gym.registry and algo in ("PPO", "SAC") and task in ("time", "effort")
+        assert env_id in gym.registry and algo in ALGORITHMS and task in ("time", "effort")
         assert {"num_envs", "total_timesteps", "seed", "algo_kwargs", "env_kwargs"} <= set(entry)
         assert isinstance(entry["seed"], int) and entry["num_envs"] >= 1
         assert entry["algo_kwargs"]["gamma"] == 0.99
@@ -28,3 +34,15 @@ def test_get_hyperparameters_sets_the_shaping_discount_and_copies() -> None:
         "shaping_discount": 0.99}
     with pytest.raises(KeyError, match="known"):
         get_hyperparameters("mdi_envs/BlockableManipulator-v0", "PPO", "effort")
+
+
+def test_hybrid_ppo_uses_the_ppo_settings_on_the_hybrid_space() -> None:
+    hybrid = get_hyperparameters("mdi_envs/BlockableManipulator-v0", "hybridppo")
+    ppo = get_hyperparameters("mdi_envs/BlockableManipulator-v0", "ppo")
+    assert hybrid["env_kwargs"] == {**ppo["env_kwargs"], "action_mode": "hybrid"}
+    assert {k: v for k, v in hybrid.items() if k != "env_kwargs"} == {
+        k: v for k, v in ppo.items() if k != "env_kwargs"}
+    assert [canonical_algorithm(a) for a in ("sac", "HYBRIDPPO", "dqn")] == [
+        "SAC", "HybridPPO", "dqn"]
+    with pytest.raises(KeyError, match="known"):
+        get_hyperparameters("mdi_envs/DiffDriveRobot-v0", "HybridPPO")

@@ -134,3 +134,33 @@ def test_set_attr_and_env_method_act_on_the_shared_env() -> None:
     assert isinstance(venv, MoreauJeanVecEnv)
     assert venv.env_method("__repr__", indices=[0, 1]) == [repr(venv.venv)] * 2
     venv.close()
+
+
+def test_hybrid_actions_equal_dummy_vec_env_in_both_layouts() -> None:
+    kwargs = {"action_mode": "hybrid", "max_episode_steps": 37}
+    ours = make_vec_env(MANIPULATOR, NUM_ENVS, **kwargs)
+    batched = make_vec_env(MANIPULATOR, NUM_ENVS, **kwargs)
+    reference = DummyVecEnv([lambda: _single(MANIPULATOR, kwargs) for _ in range(NUM_ENVS)])
+    assert ours.action_space == reference.action_space
+    for venv in (ours, batched, reference):
+        venv.seed(11)
+        venv.reset()
+    rng = np.random.default_rng(4)
+    num_dones = 0
+    for _ in range(100):
+        choices = rng.integers(0, 2, NUM_ENVS)
+        torques = rng.uniform(-1, 1, (NUM_ENVS, 1)).astype(np.float32)
+        per_copy = [(int(c), t) for c, t in zip(choices, torques, strict=True)]  # SB3's layout
+        obs, rewards, dones, infos = ours.step(per_copy)
+        obs_batched, rewards_batched, _, _ = batched.step((choices, torques))  # Gymnasium's
+        obs_ref, rewards_ref, dones_ref, infos_ref = reference.step(per_copy)
+        np.testing.assert_array_equal(obs, obs_batched)
+        np.testing.assert_array_equal(rewards, rewards_batched)
+        np.testing.assert_allclose(obs, obs_ref, rtol=1e-6, atol=1e-6)
+        np.testing.assert_allclose(rewards, rewards_ref, rtol=1e-6, atol=1e-9)
+        np.testing.assert_array_equal(dones, dones_ref)
+        assert [info["brake_engaged"] for info in infos] == (choices == 1).tolist()
+        for info, info_ref in zip(infos, infos_ref, strict=True):
+            assert info["brake_engaged"] == info_ref["brake_engaged"]
+        num_dones += int(dones.sum())
+    assert num_dones >= NUM_ENVS
