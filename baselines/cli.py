@@ -78,4 +78,53 @@ def run_train(args: argparse.Namespace) -> int:
     return 0
 
 
-__all__ = ["add_train_parser", "run_train"]
+def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``compare`` subcommand to an argparse subparsers object; returns its parser."""
+    from baselines.compare import TASKS
+
+    parser = subparsers.add_parser(
+        "compare",
+        help="shipped RL policies vs the optimal reference: success, time and effort ratios",
+        description="Play every shipped policy (baselines/trained) of ENV_ID and the optimal "
+        "reference (open loop) from the nominal start and from --seeds perturbed starts; print "
+        "success rates and time/effort ratios to the optimum as a Markdown table; write "
+        "compare_ENV_TASK.json and .png (trajectories, brake schedules / slip modes, scores) "
+        "and compare.md into --output. ENV_ID 'all' runs both mission envs, every task.",
+    )
+    parser.add_argument("env_id", choices=[*sorted(TASKS), "all"], help="the environment")
+    parser.add_argument("--task", choices=("time", "effort"), default=None,
+                        help="one task (default: every task of the env)")
+    parser.add_argument("--seeds", type=int, default=20, help="perturbed starts per controller")
+    parser.add_argument("--output", type=Path, default=Path("results/compare"),
+                        help="folder for the JSON, PNG and Markdown results")
+    parser.set_defaults(handler=run_compare)
+    return parser
+
+
+def run_compare(args: argparse.Namespace) -> int:
+    """Handler of ``compare``: runs each env x task, prints and writes the table; returns 0."""
+    import sys
+
+    from baselines.compare import TASKS, compare, markdown_table, write_comparison
+
+    if args.seeds < 1:
+        raise SystemExit(f"compare: --seeds must be >= 1, got {args.seeds}")
+    env_ids = sorted(TASKS) if args.env_id == "all" else [args.env_id]
+    jobs = [(env_id, task) for env_id in env_ids for task in TASKS[env_id]
+            if args.task in (None, task)]  # fmt: skip
+    if not jobs:
+        raise SystemExit(f"compare: {args.env_id} has no task {args.task!r}")
+    comparisons = []
+    for env_id, task in jobs:
+        comparison = compare(env_id, task, num_seeds=args.seeds,
+                             log=lambda line: print(line, file=sys.stderr, flush=True))
+        for path in write_comparison(comparison, args.output):
+            print(f"wrote {path}", file=sys.stderr)
+        comparisons.append(comparison)
+    table = markdown_table(comparisons)
+    (args.output / "compare.md").write_text(table + "\n")
+    print(table)
+    return 0
+
+
+__all__ = ["add_compare_parser", "add_train_parser", "run_compare", "run_train"]

@@ -2,7 +2,8 @@
 
 Subcommands: ``demo`` (solvers and the manipulator), ``solve`` (one Siconos file),
 ``simulate`` (one episode of an environment, optionally saved as GIF/MP4), ``optimize``
-(an optimal-control reference), ``train`` (an SB3 baseline) and ``bench`` (the benchmark suite).
+(an optimal-control reference), ``train`` (an SB3 baseline), ``compare`` (the shipped baselines
+against the optimal references) and ``bench`` (the benchmark suite).
 Each subcommand imports what it needs inside its handler.
 """
 
@@ -83,12 +84,13 @@ def _build_parser() -> argparse.ArgumentParser:
                           help="environment argument, e.g. task=effort (repeatable)")
     simulate.set_defaults(handler=_run_simulate)
 
-    from baselines.cli import add_train_parser
+    from baselines.cli import add_compare_parser, add_train_parser
     from benchmarks.cli import add_bench_parser
     from optimal.cli import add_optimize_parser
 
     add_optimize_parser(commands)
     add_train_parser(commands)
+    add_compare_parser(commands)
     add_bench_parser(commands)
     return parser
 

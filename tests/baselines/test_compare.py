@@ -126,3 +126,15 @@ def test_shipped_policies_match_env_and_task(tmp_path: Path) -> None:
     (tmp_path / "b.zip").write_bytes(b"")
     (tmp_path / "c.json").write_text(json.dumps(config))  # no zip beside it
     assert shipped_policies(DIFF_DRIVE, "effort", tmp_path) == [tmp_path / "a.json"]
+
+
+def test_compare_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from mdi_envs.cli import main
+
+    assert main(["compare", MANIPULATOR, "--seeds", "1", "--output", str(tmp_path)]) == 0
+    table = capsys.readouterr().out
+    assert f"| BlockableManipulator-v0 | time | {OPTIMAL} | " in table
+    assert (tmp_path / "compare.md").read_text().strip() == table.strip()
+    assert (tmp_path / "compare_BlockableManipulator-v0_time.png").exists()
+    with pytest.raises(SystemExit, match="has no task"):
+        main(["compare", MANIPULATOR, "--task", "effort", "--output", str(tmp_path)])
