@@ -6,6 +6,8 @@ kernels report singularity through their return value instead.
 
 from __future__ import annotations
 
+import math
+
 from numba import njit
 
 from mdi_envs._types import FloatArray
@@ -107,4 +109,32 @@ def invert_into(A: FloatArray, out: FloatArray, work: FloatArray, column: FloatA
     return True
 
 
-__all__ = ["invert_into", "lu_solve_inplace"]
+@njit(cache=True)
+def dominates_half(A: FloatArray, M: FloatArray, work: FloatArray) -> bool:
+    """Whether the symmetric part of A - M / 2 is positive definite (A, M: (n, n)).
+
+    For an iteration matrix A = M - E that perturbs an SPD mass matrix M this says the
+    perturbation E removes less than half of M's inertia in every direction: x^T A x >
+    x^T M x / 2 for all x != 0. Cholesky of (A + A^T - M) / 2 in ``work`` (n, n), overwritten.
+    """
+    n = A.shape[0]
+    for r in range(n):
+        for c in range(n):
+            work[r, c] = 0.5 * (A[r, c] + A[c, r] - M[r, c])
+    for j in range(n):
+        pivot = work[j, j]
+        for t in range(j):
+            pivot -= work[j, t] * work[j, t]
+        if not pivot > 0.0:
+            return False
+        pivot = math.sqrt(pivot)
+        work[j, j] = pivot
+        for r in range(j + 1, n):
+            acc = work[r, j]
+            for t in range(j):
+                acc -= work[r, t] * work[j, t]
+            work[r, j] = acc / pivot
+    return True
+
+
+__all__ = ["dominates_half", "invert_into", "lu_solve_inplace"]

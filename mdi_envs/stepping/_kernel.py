@@ -26,10 +26,10 @@ from numba import njit
 
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
-from mdi_envs.solvers._linalg import invert_into
+from mdi_envs.solvers._linalg import dominates_half, invert_into
 from mdi_envs.solvers.lcp.enumerative import enumerative_kernel
 from mdi_envs.solvers.lcp.lemke import lemke_kernel
-from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED
+from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
 
 GAP_TOLERANCE = 1e-12
 """[m] A contact counts as closed at the midpoint when g_i(q_M) <= this: a body resting on a
@@ -39,6 +39,11 @@ IDEAL_BRAKE_IMPULSE = 1e6
 """[N s or N m s] A brake whose impulse bound a dt reaches this acts as the ideal brake
 (equality row). The Tresca rows carry P_B = P_R - a dt, which loses all precision when a dt is
 many orders above P_B; no brake of these models needs impulses anywhere near this bound."""
+
+# Outcomes of the smooth part of a step (``make_free_motion``).
+MOTION_RESOLVED = 0  # M_theta = M - dt/2 J used
+MOTION_UNDER_RESOLVED = 1  # dt too coarse for the linearization: explicit h, status INACCURATE
+MOTION_SINGULAR = 2  # the iteration matrix could not be inverted: status BREAKDOWN
 
 # Layout of the per-step diagnostics vector.
 INFO_STATUS = 0  # SolverStatus code of the step's solve (CONVERGED when nothing to solve)
@@ -144,7 +149,11 @@ def make_free_motion(
     matrix M_theta = M(q_M) - theta dt dh/du(q_M, u) with theta = 1/2 (M_theta = M when h does
     not depend on u), into ``M`` and its inverse into ``Minv``. All arrays are modified in place;
     M^-1 is kept across steps when the model's mass is constant, h independent of u and the
-    shortcut on. Returns False if M_theta is singular.
+    shortcut on. Returns ``MOTION_RESOLVED``; ``MOTION_UNDER_RESOLVED`` when the step is too
+    coarse for the linearization (the symmetric part of M_theta does not exceed M / 2: dt |u|
+    is no longer small against the configuration scale, e.g. an arm turning about a radian per
+    step), in which case J is dropped for this step (explicit h, M_theta = M, never singular)
+    and the step reports ``INACCURATE``; ``MOTION_SINGULAR`` if the matrix cannot be inverted.
 
     The theta term makes velocity-dependent forces linearly implicit (the theta-method of
     Siconos' MoreauJeanOSI): the step then solves M(q_M)(u+ - u) = (h + theta J (u+ - u) + B tau)
@@ -167,11 +176,15 @@ def make_free_motion(
             qm[i] = q[i] + 0.5 * dt * u[i]
         forces(qm, u, p, h)
         inputs(qm, p, B)
-        ok = True
+        motion = MOTION_RESOLVED
         if not (reuse_mass and mass_ready[0] == 1):
             mass(qm, p, M)
             if velocity_forces:
-                # M -= theta dt J with theta = 1/2; probes in ufree, col and Mwork[0].
+                # M -= theta dt J with theta = 1/2; M(q_M) kept in Minv until the inversion,
+                # probes in ufree, col and Mwork[0].
+                for i in range(n):
+                    for j in range(n):
+                        Minv[i, j] = M[i, j]
                 for j in range(n):
                     for i in range(n):
                         ufree[i] = u[i]
@@ -181,8 +194,14 @@ def make_free_motion(
                     forces(qm, ufree, p, Mwork[0])
                     for i in range(n):
                         M[i, j] -= 0.25 * dt * (col[i] - Mwork[0, i])
-            ok = invert_into(M, Minv, Mwork, col)
-            mass_ready[0] = 1 if ok else 0
+                if not dominates_half(M, Minv, Mwork):  # under-resolved: drop the J term
+                    motion = MOTION_UNDER_RESOLVED
+                    for i in range(n):
+                        for j in range(n):
+                            M[i, j] = Minv[i, j]
+            if not invert_into(M, Minv, Mwork, col):
+                motion = MOTION_SINGULAR
+            mass_ready[0] = 0 if motion == MOTION_SINGULAR else 1
         for i in range(n):
             f = h[i]
             for j in range(num_inputs):
@@ -193,7 +212,7 @@ def make_free_motion(
             for j in range(n):
                 acc += Minv[i, j] * col[j]
             ufree[i] = acc
-        return ok
+        return motion
 
     return free_motion
 
@@ -237,10 +256,12 @@ def make_step_kernels(
          A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P, Mwork,
          col, row_eps) = fs
         basis, row_of, slot_of, slot_var, row_ref, row_var, mass_ready = js
-        ok = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
+        motion = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
+        ok = motion != MOTION_SINGULAR
         for i in range(c * d + k):
             impulses[i] = 0.0
-        info[INFO_STATUS] = CODE_CONVERGED if ok else CODE_BREAKDOWN
+        info[INFO_STATUS] = (CODE_BREAKDOWN if not ok else CODE_INACCURATE
+                             if motion == MOTION_UNDER_RESOLVED else CODE_CONVERGED)
         info[INFO_ITERATIONS] = 0.0
         info[INFO_ACTIVE_CONTACTS] = 0.0
         info[INFO_LCP_SIZE] = 0.0
@@ -370,6 +391,8 @@ def make_step_kernels(
             A, a, num_x, num_eq, direct_solve_max_size, v, Mred, qred, z, T, basis, row_of,
             slot_of, slot_var, pivot_row, Aee, Aee_inv, lu_work, lu_col,
         )
+        if code == CODE_CONVERGED and motion == MOTION_UNDER_RESOLVED:
+            code = CODE_INACCURATE
         info[INFO_STATUS] = code
         info[INFO_ITERATIONS] = iterations
         info[INFO_LCP_SIZE] = num_x

@@ -54,7 +54,7 @@ from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers.fc3d.newton_ac import make_workspace as make_newton_workspace
 from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
-from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED
+from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
 from mdi_envs.stepping._kernel import (
     INFO_ACTIVE_CONTACTS,
     INFO_EQUALITIES,
@@ -62,6 +62,8 @@ from mdi_envs.stepping._kernel import (
     INFO_LCP_SIZE,
     INFO_SIZE,
     INFO_STATUS,
+    MOTION_SINGULAR,
+    MOTION_UNDER_RESOLVED,
     StepShortcuts,
     make_free_motion,
 )
@@ -143,7 +145,8 @@ def make_spatial_step_kernels(
         """
         (qm, M, Minv, h, B, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho, Mwork,
          col, sliding, nws, mass_ready, r_best, warm, warm_ready) = ws
-        ok = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
+        motion = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
+        ok = motion != MOTION_SINGULAR
         for i in range(c3):
             impulses[i] = 0.0
         info[INFO_STATUS] = CODE_CONVERGED
@@ -261,6 +264,8 @@ def make_spatial_step_kernels(
             residual = best
             for i in range(c3):
                 r[i] = r_best[i]
+        if code == CODE_CONVERGED and motion == MOTION_UNDER_RESOLVED:
+            code = CODE_INACCURATE
         info[INFO_STATUS] = code
         info[INFO_ITERATIONS] = iterations
         info[INFO_RESIDUAL] = residual
