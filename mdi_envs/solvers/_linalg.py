@@ -110,17 +110,18 @@ def invert_into(A: FloatArray, out: FloatArray, work: FloatArray, column: FloatA
 
 
 @njit(cache=True)
-def dominates_half(A: FloatArray, M: FloatArray, work: FloatArray) -> bool:
-    """Whether the symmetric part of A - M / 2 is positive definite (A, M: (n, n)).
+def dominates(A: FloatArray, M: FloatArray, fraction: float, work: FloatArray) -> bool:
+    """Whether the symmetric part of A - fraction M is positive definite (A, M: (n, n)).
 
     For an iteration matrix A = M - E that perturbs an SPD mass matrix M this says the
-    perturbation E removes less than half of M's inertia in every direction: x^T A x >
-    x^T M x / 2 for all x != 0. Cholesky of (A + A^T - M) / 2 in ``work`` (n, n), overwritten.
+    perturbation E removes less than (1 - fraction) of M's inertia in every direction:
+    x^T A x > fraction x^T M x for all x != 0. Cholesky of (A + A^T) / 2 - fraction M in
+    ``work`` (n, n), overwritten.
     """
     n = A.shape[0]
     for r in range(n):
         for c in range(n):
-            work[r, c] = 0.5 * (A[r, c] + A[c, r] - M[r, c])
+            work[r, c] = 0.5 * (A[r, c] + A[c, r]) - fraction * M[r, c]
     for j in range(n):
         pivot = work[j, j]
         for t in range(j):
@@ -137,4 +138,4 @@ def dominates_half(A: FloatArray, M: FloatArray, work: FloatArray) -> bool:
     return True
 
 
-__all__ = ["dominates_half", "invert_into", "lu_solve_inplace"]
+__all__ = ["dominates", "invert_into", "lu_solve_inplace"]
