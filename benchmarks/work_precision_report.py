@@ -1,0 +1,393 @@
+"""Reporting of ``benchmarks.work_precision``: equal-time comparison, Markdown tables, plots.
+
+``equal_time_comparison`` reads MuJoCo's ball error off its Pareto front at each of our wall
+times; ``markdown_report`` prints the targets and one table per scene; ``plot_all`` draws one
+error-vs-wall-time diagram per scene and the ball's convergence plot.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks.engine_report import brake_stop_table
+from benchmarks.report import load_average_text, markdown_table, plt
+
+ERROR_FLOOR = 1e-17
+"""Exactly-zero errors are drawn at this value on log axes."""
+
+TIMED_PATHS = {
+    "mj_one_call": "one step_batch call (N = 1, check_inputs=False, num_substeps = all steps)",
+    "mj_per_phase": "one step_batch call (N = 1, check_inputs=False) per constant-command phase",
+    "mj_per_step": "one step_batch call (N = 1, 1 substep) per step from Python (the input "
+                   "changes every step)",
+    "ed": "EventDrivenIntegrator.simulate (scipy solve_ivp DOP853 with events), sampling included",
+    "mujoco_one_call": "one mj_step(model, data, nstep = all steps) call",
+    "mujoco_per_phase": "one mj_step(model, data, nstep) call per constant-command phase",
+}
+"""What each point's wall time covers (``timed_path`` of a point)."""
+
+SERIES_TITLES = {
+    "mj_enumerative": "Moreau–Jean (enumerative LCP, default)",
+    "mj_lemke": "Moreau–Jean (Lemke)",
+    "mj_newton_ac": "Moreau–Jean (semismooth Newton, Alart–Curnier)",
+    "event_driven": "event-driven (DOP853)",
+    "mujoco_formula": "MuJoCo, dampratio from ε (formula)",
+    "mujoco_calibrated": "MuJoCo, dampratio calibrated per dt",
+    "mujoco_default": "MuJoCo, brake solref (0.02, 1) (default)",
+    "mujoco_stiffest": "MuJoCo, brake solref (2 dt, 1) (stiffest)",
+}
+
+SCENE_TITLES = {
+    "ball": "Bouncing ball: mean over drops of the largest relative apex error, bounces 1–3 [-]",
+    "slope": "Block on a slope: largest |state − closed form| [m, m/s]",
+    "manipulator": "Manipulator, bang-bang torque and 3 brake engagements: largest |state − "
+                   "event-driven reference| over the 4 ms samples [rad, rad/s]",
+    "diff_drive": "Diff-drive robot: |final state − Moreau–Jean at dt_ref| [m, rad, m/s, rad/s]",
+}
+
+_CASE_COLORS = {"sliding": "tab:blue", "sticking": "tab:green", "stick_slip": "tab:red"}
+_SERIES_COLORS = {"mj_enumerative": "tab:blue", "mj_lemke": "tab:cyan",
+                  "mj_newton_ac": "tab:blue", "event_driven": "tab:green",
+                  "mujoco_formula": "tab:orange", "mujoco_calibrated": "tab:red",
+                  "mujoco_default": "tab:orange", "mujoco_stiffest": "tab:red"}
+
+
+def series_title(series: str) -> str:
+    """Readable series name (slope series are ``method:case``)."""
+    method, _, case = series.partition(":")
+    title = SERIES_TITLES.get(method, method)
+    return f"{title} · {case}" if case else title
+
+
+def target_row(name: str, threshold: str, measured: float | int | None, met: bool | None,
+               note: str = "") -> dict[str, Any]:
+    """One target check (``met`` None: not measured)."""
+    return {"target": name, "threshold": threshold, "measured": measured, "met": met,
+            "note": note}
+
+
+def _format(value: float | int | None) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    if isinstance(value, int):
+        return str(value)
+    if value == 0.0:
+        return "0"
+    return f"{value:.3g}" if 1e-2 <= abs(value) < 1e4 else f"{value:.2e}"
+
+
+def _mark(met: bool | None) -> str:
+    return "–" if met is None else ("✓" if met else "✗")
+
+
+# ---------------------------------------------------------------------- equal-time comparison
+def pareto_front(points: Sequence[Mapping[str, Any]]) -> list[tuple[float, float, str]]:
+    """(wall time [s], error, label) of the points no other point beats in both, by time."""
+    usable = sorted((p["wall_time_s"], p["error"], f"{p['series']} dt={p['value']:g}")
+                    for p in points
+                    if p.get("error") is not None and p["wall_time_s"] is not None)
+    front: list[tuple[float, float, str]] = []
+    for seconds, error, label in usable:
+        if not front or error < front[-1][1]:
+            front.append((seconds, error, label))
+    return front
+
+
+def interpolate_front(front: Sequence[tuple[float, float, str]], seconds: float
+                      ) -> tuple[float | None, str]:
+    """MuJoCo's error at ``seconds`` on its front (see ``equal_time_comparison``)."""
+    times = [f[0] for f in front]
+    if seconds <= times[0]:
+        return front[0][1], "clamped"
+    if seconds > times[-1]:
+        return None, "beyond"
+    i = int(np.searchsorted(times, seconds))
+    (t0, e0, _), (t1, e1, _) = front[i - 1], front[i]
+    w = math.log(seconds / t0) / math.log(t1 / t0)
+    return math.exp((1.0 - w) * math.log(e0) + w * math.log(e1)), "interpolated"
+
+
+def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
+                          mujoco: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """MuJoCo's ball error divided by ours at our wall times.
+
+    MuJoCo's points (all its series pooled, failed runs left out) are reduced to their Pareto
+    front: sorted by wall time, each point kept if its error is below every faster point's
+    (what a user choosing the best MuJoCo setting for a time budget gets). At each of our wall
+    times t, MuJoCo's error is interpolated linearly in (log t, log error) between the two
+    front points around t ("interpolated": an equal-time ratio). Where our run is faster than
+    MuJoCo's fastest front point, that point's error is used ("clamped": MuJoCo is given more
+    time than ours, so the ratio is a lower bound); where ours is slower than MuJoCo's slowest
+    point, nothing is compared ("beyond").
+
+    Returns:
+        ``rows`` (per our point: dt, wall time, our error, MuJoCo's, how, ratio), ``min_ratio``
+        and ``max_ratio`` (over every compared point), ``min_equal_time_ratio`` (interpolated
+        points), ``min_lower_bound_ratio`` (clamped points), ``ratio_at_1ms`` (None when not
+        compared), ``front`` and ``summary``.
+    """
+    front = pareto_front(mujoco)
+    rows = []
+    for p in sorted(ours, key=lambda p: -p["value"]):
+        if p.get("error") is None or not front:
+            continue
+        theirs, how = interpolate_front(front, p["wall_time_s"])
+        ratio = None if theirs is None or p["error"] == 0.0 else theirs / p["error"]
+        rows.append({"dt": p["value"], "wall_time_s": p["wall_time_s"], "error": p["error"],
+                     "mujoco_error": theirs, "how": how, "ratio": ratio})
+    ratios = [r["ratio"] for r in rows if r["ratio"] is not None]
+    equal = [r["ratio"] for r in rows if r["ratio"] is not None and r["how"] == "interpolated"]
+    bounds = [r["ratio"] for r in rows if r["ratio"] is not None and r["how"] == "clamped"]
+    at_1ms = next((r for r in rows if math.isclose(r["dt"], 1e-3)), None)
+    result: dict[str, Any] = {
+        "rows": rows, "front": [list(f) for f in front],
+        "min_ratio": min(ratios) if ratios else None,
+        "max_ratio": max(ratios) if ratios else None,
+        "min_equal_time_ratio": min(equal) if equal else None,
+        "min_lower_bound_ratio": min(bounds) if bounds else None,
+        "ratio_at_1ms": None if at_1ms is None else at_1ms["ratio"],
+    }
+    parts = []
+    if equal:
+        parts.append(f"at equal time (interpolated) {_format(min(equal))}–{_format(max(equal))}× "
+                     f"over {len(equal)} of our dt")
+    if bounds:
+        parts.append(f"where ours is faster than any MuJoCo run (clamped: lower bounds) "
+                     f"{_format(min(bounds))}–{_format(max(bounds))}× over {len(bounds)} of our dt")
+    if at_1ms is not None and at_1ms["ratio"] is not None:
+        parts.append(f"at dt = 1e-3: {_format(at_1ms['ratio'])}× ({at_1ms['how']})")
+    result["summary"] = "; ".join(parts) or "no comparable point"
+    return result
+
+
+# ---------------------------------------------------------------------------------- Markdown
+def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
+    """Markdown: target, threshold, measured, met, note."""
+    rows = [[t["target"], t["threshold"], _format(t["measured"]), _mark(t["met"]), t["note"]]
+            for t in targets]
+    return markdown_table(["target", "threshold", "measured", "met", "note"], rows)
+
+
+def _details(p: Mapping[str, Any]) -> str:
+    """The point's secondary measurements as short text."""
+    parts = []
+    if p.get("error_max") is not None:
+        parts.append(f"worst drop {_format(p['error_max'])}")
+    if p.get("impact_time_error_s") is not None:
+        parts.append(f"impact times {_format(p['impact_time_error_s'])} s")
+    if p.get("final_error") is not None:
+        parts.append(f"final {_format(p['final_error'])}")
+    if p.get("speed_error") is not None:
+        parts.append(f"speed {_format(p['speed_error'])}")
+    if p.get("effective_restitution") is not None:
+        parts.append(f"ε_eff {p['effective_restitution']:.4f} (dampratio "
+                     f"{p['dampratio']:.4f})")
+    if p.get("worst_solver_status") not in (None, "CONVERGED"):
+        parts.append(f"solver {p['worst_solver_status']}")
+    if p.get("replay_difference"):
+        parts.append(f"replay differs by {_format(p['replay_difference'])}")
+    if p["status"] != "ok":
+        parts.append(p["status"])
+    return "; ".join(parts)
+
+
+def scene_table(points: Sequence[Mapping[str, Any]]) -> str:
+    """Markdown: series, dt or rtol, wall time [ms], error, details."""
+    rows = [[series_title(p["series"]), f"{p['parameter']} = {p['value']:g}",
+             "–" if p["wall_time_s"] is None else _format(p["wall_time_s"] * 1e3),
+             _format(p.get("error")), _details(p)]
+            for p in points]
+    return markdown_table(["series", "step / tolerance", "wall time ms", "error", "details"], rows)
+
+
+def comparison_table(comparison: Mapping[str, Any]) -> str:
+    """Markdown: our dt, wall time, our error, MuJoCo's there, how, ratio."""
+    rows = [[f"{r['dt']:g}", _format(r["wall_time_s"] * 1e3), _format(r["error"]),
+             _format(r["mujoco_error"]), r["how"], _format(r["ratio"])]
+            for r in comparison["rows"]]
+    return markdown_table(["our dt [s]", "wall time ms", "our error", "MuJoCo error there",
+                           "how", "MuJoCo / ours"], rows)
+
+
+def markdown_report(record: Mapping[str, Any]) -> str:
+    """The targets, the equal-time comparison and one table per scene."""
+    machine = record["machine"]
+    versions = machine["versions"]
+    lines = [
+        f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
+        f"numpy {versions.get('numpy')}, numba {versions.get('numba')}, scipy "
+        f"{versions.get('scipy')}, mujoco {versions.get('mujoco')}; total "
+        f"{record['run_time_s']:.0f} s{' (--quick)' if record['config']['quick'] else ''}; "
+        f"{load_average_text(machine)}.",
+    ]
+    if record["notes"]:
+        lines += ["", *(f"* {note}" for note in record["notes"])]
+    lines += ["", "**Targets** (reported, not enforced)", "", targets_table(record["targets"])]
+    comparison = record.get("equal_time")
+    if comparison and comparison["rows"]:
+        lines += ["", "**Ball: MuJoCo's error / ours at equal wall time.** MuJoCo's ball points "
+                  "(both dampratio series; failed runs left out) are reduced to their Pareto "
+                  "front; at each of our wall times its error is interpolated linearly in (log "
+                  "time, log error) between the two front points around it. Where ours is "
+                  "faster than MuJoCo's fastest front point, that point's error is used "
+                  "(clamped: MuJoCo gets more time than ours, so the ratio is a lower bound); "
+                  "beyond MuJoCo's slowest point nothing is compared. The target is judged on "
+                  "the equal-time (interpolated) ratios, or on the lower bounds when there are "
+                  f"none. Result: {comparison['summary']}.", "", comparison_table(comparison)]
+    if record["compile"]:
+        rows = [[c["model"], c["method"], f"{c['first_step_batch_s']:.1f}"]
+                for c in record["compile"]]
+        lines += ["", "**Compile time** (first step_batch call per kernel, excluded from every "
+                  "wall time)", "", markdown_table(["model", "method", "seconds"], rows)]
+    for scene, title in SCENE_TITLES.items():
+        points = [p for p in record["points"] if p["scene"] == scene]
+        if points:
+            lines += ["", f"**{title}**", "", scene_table(points)]
+            lines += _reference_lines(scene, record)
+    lines += ["", "Timed paths: " + "; ".join(
+        f"`{k}` = {v}" for k, v in record["timed_paths"].items()) + "."]
+    if record.get("brake_stop"):
+        lines += ["", "**Brake stop** (`benchmarks.engine.brake_stop_study`, dt = 1e-3 s: "
+                  "relative velocity 1 rad/s, link 1 at rest, no torque; then the brake "
+                  "engages)", "", brake_stop_table(record["brake_stop"])]
+    return "\n".join(lines)
+
+
+def _reference_lines(scene: str, record: Mapping[str, Any]) -> list[str]:
+    """The scene's reference description or calibration table, if any."""
+    ref = record["references"].get(scene)
+    if scene == "manipulator" and ref:
+        return ["", f"Reference: event-driven, rtol {ref['rtol']:g}, atol {ref['atol']:g} "
+                f"({ref['wall_time_s']:.2f} s); its difference from rtol {ref['check_rtol']:g} "
+                f"is {ref['self_difference']:.1e} over the {ref['samples']} samples."]
+    if scene == "diff_drive" and ref:
+        return ["", f"Reference: Moreau–Jean at dt_ref = {ref['time_step']:g} s "
+                f"({ref['wall_time_s']:.1f} s, solver {ref['worst_status']}); its difference from "
+                f"dt = {ref['check_time_step']:g} s is {ref['self_difference']:.1e} (≈ its own "
+                "error for a first-order method)."]
+    if scene == "ball" and record.get("mujoco_ball_calibration"):
+        rows = [[series_title(c["series"]), f"{c['dt']:g}", f"{c['dampratio']:.5f}",
+                 _format(c["effective_restitution"]), c["note"]]
+                for c in record["mujoco_ball_calibration"]]
+        first = record["mujoco_ball_calibration"][0]
+        return ["", f"MuJoCo ball contact: solref (timeconst {first['solref'][0]:g} s, "
+                "dampratio), solimp (" + ", ".join(f"{x:g}" for x in first["solimp"][:3])
+                + "); effective restitution = sqrt(rebound apex / drop) of a 0.5 m drop:", "",
+                markdown_table(["series", "dt [s]", "dampratio", "ε_eff", "note"], rows)]
+    return []
+
+
+# ------------------------------------------------------------------------------------- plots
+def _zero_floor(points: Sequence[Mapping[str, Any]]) -> float:
+    """Where errors of exactly 0 are drawn: a decade below the smallest positive error."""
+    positive = [p["error"] for p in points if p.get("error")]
+    return min(ERROR_FLOOR, 0.1 * min(positive)) if positive else ERROR_FLOOR
+
+
+def _save(fig: Any, path: Path) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def _style(series: str) -> dict[str, Any]:
+    method, _, case = series.partition(":")
+    if case:
+        return {"color": _CASE_COLORS.get(case, "k"),
+                "ls": "-" if method == "mj_enumerative" else "--",
+                "marker": "o" if method == "mj_enumerative" else "x", "ms": 5}
+    if method == "mj_lemke":  # drawn over the default method's line, which it often equals
+        return {"color": _SERIES_COLORS[method], "ls": "--", "marker": "x", "ms": 6}
+    marker = "o" if method.startswith("mj") else ("^" if method == "event_driven" else "s")
+    return {"color": _SERIES_COLORS.get(method, "k"), "ls": "-", "marker": marker, "ms": 5}
+
+
+def plot_scene(points: Sequence[Mapping[str, Any]], scene: str, path: Path) -> None:
+    """Log-log error against wall time, one line per series, each point labelled by dt/rtol."""
+    fig, ax = plt.subplots(figsize=(8.0, 5.4))
+    floor = _zero_floor(points)
+    for series in dict.fromkeys(p["series"] for p in points):
+        chosen = sorted((p for p in points if p["series"] == series
+                         and p.get("error") is not None), key=lambda p: -p["value"])
+        if not chosen:
+            continue
+        x = np.array([p["wall_time_s"] * 1e3 for p in chosen])
+        y = np.array([p["error"] if p["error"] > 0.0 else floor for p in chosen])
+        ax.plot(x, y, label=series_title(series), lw=1.2, **_style(series))
+        for p, xi, yi in zip(chosen, x, y, strict=True):
+            ax.annotate(f"{p['value']:g}", (xi, yi), textcoords="offset points", xytext=(3, 3),
+                        fontsize=6, color=_style(series)["color"])
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylabel("error")
+    ax.set_title(textwrap.fill(SCENE_TITLES.get(scene, scene), 95), fontsize=9)
+    ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    ax.legend(fontsize=7)
+    note = "wall time per trajectory [ms]   (point labels: dt [s] or rtol"
+    if any(p.get("error") == 0.0 for p in points):
+        note += f"; errors of exactly 0 drawn at {floor:.0e}"
+    ax.set_xlabel(note + ")")
+    _save(fig, path)
+
+
+def plot_ball_convergence(points: Sequence[Mapping[str, Any]], path: Path) -> None:
+    """Ball error against dt (log-log), with an O(dt) slope and the 1e-3 target marked."""
+    fig, ax = plt.subplots(figsize=(7.0, 5.0))
+    stepped = [p for p in points if p["parameter"] == "dt" and p.get("error") is not None]
+    for series in dict.fromkeys(p["series"] for p in stepped):
+        chosen = sorted((p for p in stepped if p["series"] == series), key=lambda p: p["value"])
+        ax.plot([p["value"] for p in chosen], [p["error"] for p in chosen],
+                label=series_title(series), lw=1.2, **_style(series))
+    ours = sorted((p for p in stepped if p["series"] == "mj_enumerative"),
+                  key=lambda p: p["value"])
+    if ours:
+        dts = np.array([p["value"] for p in ours])
+        anchor = ours[len(ours) // 2]
+        ax.plot(dts, anchor["error"] * dts / anchor["value"], "k:", lw=1.0,
+                label="O(dt) reference slope")
+    ax.plot([1e-3], [1e-3], marker="*", color="k", ms=10, ls="none",
+            label="target: 1e-3 at dt = 1e-3 s")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time step dt [s]")
+    ax.set_ylabel("mean largest relative apex error, bounces 1–3")
+    ax.set_title("Bouncing ball: convergence in dt", fontsize=9)
+    ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    ax.legend(fontsize=7)
+    _save(fig, path)
+
+
+def plot_all(points: Sequence[Mapping[str, Any]], scenes: Sequence[str], output: Path
+             ) -> list[str]:
+    """Every plot of the run; returns the file names written."""
+    names = []
+    for scene in scenes:
+        chosen = [p for p in points if p["scene"] == scene]
+        name = f"work_precision_{scene}.png"
+        plot_scene(chosen, scene, output / name)
+        names.append(name)
+        if scene == "ball":
+            plot_ball_convergence(chosen, output / "work_precision_ball_convergence.png")
+            names.append("work_precision_ball_convergence.png")
+    return names
+
+
+__all__ = [
+    "ERROR_FLOOR",
+    "SCENE_TITLES",
+    "SERIES_TITLES",
+    "TIMED_PATHS",
+    "equal_time_comparison",
+    "interpolate_front",
+    "markdown_report",
+    "pareto_front",
+    "plot_all",
+    "series_title",
+    "target_row",
+]
