@@ -1,7 +1,7 @@
-"""Benchmarks of the LCP solvers, the time-stepping engine (vs MuJoCo) and the environments.
+"""The benchmark suite: solvers, engine and envs speed, work-precision, numerical stress.
 
-Run ``python -m benchmarks.solvers``, ``python -m benchmarks.engine`` and
-``python -m benchmarks.envs``.
+Run ``mdi-envs bench [NAME ...] [--quick]`` (``benchmarks.cli``; NAME in solvers, engine, envs,
+precision, stress) or each module alone, e.g. ``python -m benchmarks.stress --quick``.
 
 Modules:
     problems: the seeded random LCP families and the Siconos peer problems.
@@ -18,4 +18,9 @@ Modules:
     engine: the command line of the engine benchmark.
     envs: env.step through gym.make and vector-env throughput vs Acrobot-v1 and MuJoCo's
         InvertedDoublePendulum-v5 (its report: envs_report).
+    work_precision: error against wall time per scene, ours vs the event-driven reference and
+        MuJoCo (work_precision_mujoco: the MuJoCo ball and arm; work_precision_report).
+    stress: Zeno balls, brake toggling, dt and mu sweeps, overdrive, degenerate LCPs, long
+        horizons, each with pass/fail criteria (stress_report: criteria, table, plot).
+    cli: ``mdi-envs bench``; headline: the table of every target and verdict in one.
 """

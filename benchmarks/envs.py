@@ -3,7 +3,7 @@
 Usage (from the repository root)::
 
     python -m benchmarks.envs --output results/bench
-    python -m benchmarks.envs --output /tmp/bench --quick   # N <= 256, small budgets
+    python -m benchmarks.envs --output /tmp/bench --quick   # manipulator vs Acrobot, N <= 256
 
 Writes ``envs.json``, ``envs_step.png`` and ``envs_vector.png`` to the output folder, prints
 progress lines on stderr and the Markdown results tables (the ones in ``benchmarks/README.md``)
@@ -108,11 +108,11 @@ FULL = EnvsConfig(
     vector_plan=TimingPlan(budget_s=0.6, min_rounds=9, max_rounds=61, min_batch_s=5e-3),
 )
 QUICK = EnvsConfig(
-    env_ids=None,
-    peers=(ACROBOT, MUJOCO_PEER),
+    env_ids=("mdi_envs/BlockableManipulator-v0",),
+    peers=(ACROBOT,),
     sync_peer=ACROBOT,
     sync_max_copies=256,
-    copies=(1, 4, 16, 64, 256),
+    copies=(1, 16, 256),
     action_samples=256,
     step_plan=TimingPlan(budget_s=0.2, min_rounds=9, max_rounds=51, min_batch_s=2e-3),
     vector_plan=TimingPlan(budget_s=0.1, min_rounds=5, max_rounds=15, min_batch_s=2e-3),
