@@ -18,16 +18,16 @@ $(VENV)/.installed-%: pyproject.toml
 	$(BIN)/python -m pip install --quiet -e ".[$*]"
 	touch $@
 
-demo: $(VENV)/.installed-render
+demo: $(VENV)/.installed-rl,render
 	$(BIN)/mdi-envs demo --output results/demo
+	$(BIN)/mdi-envs compare all --output results/compare
 
 test: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -q
+	$(BIN)/mdi-envs bench --quick
 
 bench: $(VENV)/.installed-bench
-	$(BIN)/python -m benchmarks.solvers --output results/bench
-	$(BIN)/python -m benchmarks.engine --output results/bench
-	$(BIN)/python -m benchmarks.envs --output results/bench
+	$(BIN)/mdi-envs bench
 
 lint: $(VENV)/.installed-dev
 	$(BIN)/ruff check mdi_envs optimal baselines tests benchmarks
