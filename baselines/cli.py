@@ -3,7 +3,7 @@
 Wiring (in ``mdi_envs/cli.py``): ``from baselines.cli import add_train_parser`` and call
 ``add_train_parser(commands)`` on the subparsers; the parser's handler is ``run_train``.
 Example: ``mdi-envs train mdi_envs/DiffDriveRobot-v0 PPO --task effort --output
-results/baselines`` (3 x 10^6 steps; the budget and settings are in
+results/baselines`` (5 x 10^6 steps; the budget and settings are in
 ``baselines/hyperparameters.py``) shows SB3's progress bar on a terminal and writes the model
 zip, its JSON config, the episode CSV, the training-curve PNG and TensorBoard logs into
 ``--output``. ``--timesteps 20000`` gives a run of a minute or two. ``mdi-envs train

@@ -16,9 +16,12 @@ brake x Gaussian torque policy) on the manipulator's native ``action_mode="hybri
 - SAC with fewer copies (8) and ``gradient_steps = num_envs`` (one gradient step per env
   transition, SAC's usual replay ratio), 10^6 buffer, batch 256, 2 x 256 ReLU MLPs, automatic
   entropy tuning, 10^4 random warm-up steps.
-- Budgets: PPO and HybridPPO 3 x 10^6 steps, SAC 3 x 10^5 (episodes: manipulator up to 500
-  steps of 0.02 s, the optimum takes about 228; diff drive "time" up to 200 steps of 0.05 s,
-  "effort" exactly 81). Untuned starting points: the shipped results say how far they get.
+- Budgets, the ones of the shipped policies (``baselines/trained``): PPO 10^7 steps on the
+  manipulator and 5 x 10^6 on each diff-drive task, HybridPPO 5 x 10^6, SAC 2 x 10^5 (what
+  fitted one session on the 2-core machine: PPO runs at about 3-15 k steps/s there, SAC at a
+  few hundred). Episodes: manipulator up to 500 steps of 0.02 s, the optimum takes about 228;
+  diff drive "time" up to 200 steps of 0.05 s, "effort" exactly 81. Untuned starting points:
+  the shipped results say how far they get.
 - Seed 0 everywhere; ``train(..., seed=...)`` overrides it.
 """
 
@@ -41,7 +44,6 @@ ALGORITHM_CLASSES = {
 
 _PPO: dict[str, Any] = {
     "num_envs": 64,
-    "total_timesteps": 3_000_000,
     "seed": 0,
     "algo_kwargs": {
         "n_steps": 256, "batch_size": 2048, "n_epochs": 10, "learning_rate": 3e-4,
@@ -52,7 +54,6 @@ _PPO: dict[str, Any] = {
 }
 _SAC: dict[str, Any] = {
     "num_envs": 8,
-    "total_timesteps": 300_000,
     "seed": 0,
     "algo_kwargs": {
         "buffer_size": 1_000_000, "batch_size": 256, "learning_rate": 3e-4, "gamma": 0.99,
@@ -62,18 +63,20 @@ _SAC: dict[str, Any] = {
 }
 
 
-def _entry(base: dict[str, Any], env_kwargs: dict[str, Any]) -> dict[str, Any]:
-    return {**copy.deepcopy(base), "env_kwargs": dict(env_kwargs)}
+def _entry(base: dict[str, Any], env_kwargs: dict[str, Any], total_timesteps: int
+           ) -> dict[str, Any]:  # fmt: skip
+    return {**copy.deepcopy(base), "env_kwargs": dict(env_kwargs),
+            "total_timesteps": total_timesteps}  # fmt: skip
 
 
 HYPERPARAMETERS: dict[tuple[str, str, str], dict[str, Any]] = {
-    (MANIPULATOR, "time", "PPO"): _entry(_PPO, {}),
-    (MANIPULATOR, "time", "SAC"): _entry(_SAC, {}),
-    (MANIPULATOR, "time", "HybridPPO"): _entry(_PPO, {"action_mode": "hybrid"}),
-    (DIFF_DRIVE, "time", "PPO"): _entry(_PPO, {"task": "time"}),
-    (DIFF_DRIVE, "time", "SAC"): _entry(_SAC, {"task": "time"}),
-    (DIFF_DRIVE, "effort", "PPO"): _entry(_PPO, {"task": "effort"}),
-    (DIFF_DRIVE, "effort", "SAC"): _entry(_SAC, {"task": "effort"}),
+    (MANIPULATOR, "time", "PPO"): _entry(_PPO, {}, 10_000_000),
+    (MANIPULATOR, "time", "SAC"): _entry(_SAC, {}, 200_000),
+    (MANIPULATOR, "time", "HybridPPO"): _entry(_PPO, {"action_mode": "hybrid"}, 5_000_000),
+    (DIFF_DRIVE, "time", "PPO"): _entry(_PPO, {"task": "time"}, 5_000_000),
+    (DIFF_DRIVE, "time", "SAC"): _entry(_SAC, {"task": "time"}, 200_000),
+    (DIFF_DRIVE, "effort", "PPO"): _entry(_PPO, {"task": "effort"}, 5_000_000),
+    (DIFF_DRIVE, "effort", "SAC"): _entry(_SAC, {"task": "effort"}, 200_000),
 }
 """(env id, task, algorithm) -> {"num_envs", "total_timesteps", "seed", "algo_kwargs" (SB3
 constructor arguments), "env_kwargs" (``gym.make`` arguments; ``shaping_discount`` is added
