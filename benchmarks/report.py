@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -339,6 +340,23 @@ def _short(status: str) -> str:
     return status.lower().replace("_", " ")
 
 
+def json_safe(value: Any) -> Any:
+    """``value`` as strict JSON: non-finite floats as the strings "inf", "-inf", "nan".
+
+    A diverged measurement thus stays visible; numpy scalars become Python numbers, tuples
+    lists.
+    """
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else str(float(value))
+    return value
+
+
 def write_json(record: dict[str, Any], path: Path) -> None:
     """Write the full record (indented, NaN-free numbers as produced)."""
     path.write_text(json.dumps(record, indent=1, default=_to_builtin) + "\n")
@@ -352,6 +370,7 @@ def _to_builtin(value: Any) -> Any:
 
 
 __all__ = [
+    "json_safe",
     "ENTRY_KEYS",
     "aggregate_size_study",
     "format_residual",

@@ -1344,21 +1344,10 @@ def run(output: Path, quick: bool, log: Callable[[str], None] | None = None) -> 
     record["machine"]["load_average_at_end"] = load_average()
     record["run_time_s"] = progress.elapsed
     plot_margins(cases, output / "stress.png")
-    report.write_json(_json_safe(record), output / "stress.json")
+    report.write_json(report.json_safe(record), output / "stress.json")
     log(f"done in {progress.elapsed:.0f} s: {len(cases) - record['num_failed']} of {len(cases)} "
         f"cases pass; wrote stress.json and stress.png to {output}")
     return record
-
-
-def _json_safe(value: Any) -> Any:
-    """Replace non-finite floats (not valid JSON) by the strings "inf", "-inf", "nan"."""
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, (float, np.floating)) and not math.isfinite(value):
-        return str(float(value))
-    return value
 
 
 def main(argv: Sequence[str] | None = None) -> int:

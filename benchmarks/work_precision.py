@@ -940,24 +940,11 @@ def run(output: Path, quick: bool, log: Log | None = None,
     record["run_time_s"] = progress.elapsed
     scenes = [s for s in config.scenes if any(p["scene"] == s for p in points)]
     record["plots"] = R.plot_all(points, scenes, output)
-    record = json_safe(record)
+    record = report.json_safe(record)
     report.write_json(record, output / "work_precision.json")
     log(f"done in {progress.elapsed:.0f} s; wrote work_precision.json and "
         f"{len(record['plots'])} plots to {output}")
     return record
-
-
-def json_safe(value: Any) -> Any:
-    """``value`` with every non-finite float replaced by None (strict JSON), tuples as lists."""
-    if isinstance(value, dict):
-        return {k: json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_safe(v) for v in value]
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    return value
 
 
 def _brake_stop(ctx: Context) -> dict[str, Any]:
