@@ -56,7 +56,7 @@ def engine_peer_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
     and the steps the brake takes to stop relative motion (ours against MuJoCo's eq_active).
     """
     rows = []
-    largest = {}
+    largest: dict[str, dict[str, Any]] = {}
     for entry in record.get("batched") or []:
         if entry["model"] in ("manipulator", "mujoco"):
             if entry["copies"] >= largest.get(entry["model"], {}).get("copies", 0):
