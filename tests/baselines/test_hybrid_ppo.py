@@ -200,7 +200,7 @@ def test_train_hybrid_ppo_smoke(tmp_path: Path) -> None:
     config = json.loads(path.with_suffix(".json").read_text())
     assert config["algo"] == "HybridPPO" and config["seed"] == 3
     assert config["num_timesteps"] >= 1000 and config["num_episodes"] >= 1
-    assert config["env_kwargs"] == {"action_mode": "hybrid", "shaping_discount": 0.99}
+    assert config["env_kwargs"] == {"action_mode": "hybrid", "shaping_discount": 1.0}
     assert config["algo_kwargs"]["policy_kwargs"] == TINY["policy_kwargs"]
     assert np.isfinite(config["evaluation"]["mean_return"])
     for suffix in (".zip", ".png"):

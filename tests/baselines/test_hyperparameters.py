@@ -39,7 +39,8 @@ def test_get_hyperparameters_sets_the_shaping_discount_and_copies() -> None:
 def test_hybrid_ppo_uses_the_ppo_settings_on_the_hybrid_space() -> None:
     hybrid = get_hyperparameters("mdi_envs/BlockableManipulator-v0", "hybridppo")
     ppo = get_hyperparameters("mdi_envs/BlockableManipulator-v0", "ppo")
-    assert hybrid["env_kwargs"] == {**ppo["env_kwargs"], "action_mode": "hybrid"}
+    assert hybrid["env_kwargs"] == {**ppo["env_kwargs"], "action_mode": "hybrid",
+                                    "shaping_discount": 1.0}  # fmt: skip
     same = ("num_envs", "seed", "algo_kwargs")  # the budgets differ (10^7 vs 5 x 10^6)
     assert {k: hybrid[k] for k in same} == {k: ppo[k] for k in same}
     assert [canonical_algorithm(a) for a in ("sac", "HYBRIDPPO", "dqn")] == [
