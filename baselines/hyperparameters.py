@@ -23,7 +23,8 @@ brake x Gaussian torque policy) on the manipulator's native ``action_mode="hybri
   transition, SAC's usual replay ratio), 10^6 buffer, batch 256, 2 x 256 ReLU MLPs, automatic
   entropy tuning, 10^4 random warm-up steps.
 - Budgets, the ones of the shipped policies (``baselines/trained``): PPO 10^7 steps on the
-  manipulator and 5 x 10^6 on each diff-drive task, HybridPPO 5 x 10^6, SAC 2 x 10^5 (what
+  manipulator, 4 x 10^6 on diff drive "time", 5 x 10^6 on "effort", HybridPPO 5 x 10^6,
+  SAC 2 x 10^5 (what
   fitted one session on the 2-core machine: PPO runs at about 3-15 k steps/s there, SAC at a
   few hundred). Episodes: manipulator up to 500 steps of 0.02 s, the optimum takes about 228;
   diff drive "time" up to 200 steps of 0.05 s, "effort" exactly 81. Untuned starting points:
