@@ -1,6 +1,6 @@
 """LCP solver benchmark: work vs size for every method, and our Lemke against QuantEcon's.
 
-Usage (from the repository root; ``make bench`` runs the first line)::
+Usage (from the repository root; ``mdi-envs bench solvers`` runs it into benchmarks/results)::
 
     python -m benchmarks.solvers --output results/bench
     python -m benchmarks.solvers --output /tmp/bench --quick   # about 10 s, for tests
