@@ -35,6 +35,7 @@ TIMED_PATHS = {
 SERIES_TITLES = {
     "mj_enumerative": "Moreau–Jean (enumerative LCP, default)",
     "mj_lemke": "Moreau–Jean (Lemke)",
+    "mj_located": "Moreau–Jean, impacts located (locate_impacts=True)",
     "mj_newton_ac": "Moreau–Jean (semismooth Newton, Alart–Curnier)",
     "event_driven": "event-driven (DOP853)",
     "mujoco_formula": "MuJoCo, dampratio from ε (formula)",
@@ -53,6 +54,7 @@ SCENE_TITLES = {
 
 _CASE_COLORS = {"sliding": "tab:blue", "sticking": "tab:green", "stick_slip": "tab:red"}
 _SERIES_COLORS = {"mj_enumerative": "tab:blue", "mj_lemke": "tab:cyan",
+                  "mj_located": "tab:purple",
                   "mj_newton_ac": "tab:blue", "event_driven": "tab:green",
                   "mujoco_formula": "tab:orange", "mujoco_calibrated": "tab:red",
                   "mujoco_default": "tab:orange", "mujoco_stiffest": "tab:red"}

@@ -95,6 +95,7 @@ class MoreauJeanTask:
         effort_weight: weight of sum(tau^2) dt in the "effort" objective.
         reset_noise_scale: half-width of the uniform noise added to the start state.
         shortcuts: the stepper's exact shortcuts (``StepShortcuts``).
+        locate_impacts: the stepper's impact location (``MoreauJeanStepper``; contact scenes).
     """
 
     MODEL: ClassVar[type[ModelDefinition]]
@@ -116,6 +117,7 @@ class MoreauJeanTask:
         effort_weight: float = 1.0,
         reset_noise_scale: float = 0.0,
         shortcuts: StepShortcuts | None = None,
+        locate_impacts: bool = False,
     ) -> None:
         self._constants_cache: FloatArray | None = None
         self._kernels: tuple[Any, Any, Any] | None = None
@@ -128,7 +130,7 @@ class MoreauJeanTask:
                  f"objective must be one of {self.OBJECTIVE_OPTIONS}, got {objective!r}")
         self.stepper = MoreauJeanStepper(
             self.MODEL, parameters, require_positive("time_step", time_step),
-            shortcuts if shortcuts is not None else StepShortcuts(),
+            shortcuts if shortcuts is not None else StepShortcuts(), bool(locate_impacts),
         )
         self.parameters = self.stepper.parameters
         self.frame_skip = int(frame_skip)

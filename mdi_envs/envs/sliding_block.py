@@ -174,6 +174,7 @@ class SlidingBlockEnv(MoreauJeanEnv):
     | shaping_discount     | float | 0.99    | gamma of the shaping term                      |
     | reset_noise_scale    | float | 0.01    | start noise half-width on s, s' [m, m/s]       |
     | shortcuts            | StepShortcuts | all on | the stepper's exact shortcuts           |
+    | locate_impacts       | bool  | False   | split steps at impacts (``MoreauJeanStepper``) |
     | render_mode          | str   | None    | "rgb_array" or "human"                         |
 
     Invalid physics raise ValueError naming the field (e.g. `friction_coefficient=-0.1`,

@@ -99,6 +99,10 @@ def _workspace_layout(model: type[ModelDefinition]) -> tuple[Layout, int, Layout
         "pivot_row": (lcp + 2,), "Aee": (k, k), "Aee_inv": (k, k), "lu_work": (k, k),
         "lu_col": (k,), "v": (size,), "P": (rows,), "Mwork": (n, n), "col": (n,),
         "row_eps": (rows,),
+        # the impact-locating step (``locate_impacts``): gaps at t_k, the state at the
+        # impact, and one part's impulses and diagnostics
+        "g0": (c,), "q_hit": (n,), "u_hit": (n,), "part_impulses": (rows,),
+        "part_info": (INFO_SIZE,),
     }
     int_shapes: dict[str, tuple[int, ...]] = {
         "basis": (lcp,), "row_of": (2 * lcp + 1,), "slot_of": (2 * lcp + 1,),
@@ -222,14 +226,24 @@ def make_free_motion(
 
 
 def make_step_kernels(
-    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts
+    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts,
+    locate_impacts: bool = False,
 ) -> tuple[Any, Any]:
-    """Compile ``step(...)`` and ``step_batch(...)`` for ``model`` (see their docstrings)."""
+    """Compile ``step(...)`` and ``step_batch(...)`` for ``model`` (see their docstrings).
+
+    ``locate_impacts``: take each step with ``located_advance`` instead of ``advance`` (models
+    with contacts and without brakes only).
+    """
     n = model.NUM_DOFS
     c, d, k = model.NUM_CONTACTS, model.CONTACT_DIMENSION, model.NUM_BRAKES
     if c > 0 and d != 2:
         raise NotImplementedError(
             f"{model.__name__}: contact_dimension {d}; the LCP step handles planar contacts"
+        )
+    if locate_impacts and (c == 0 or k > 0):
+        raise ValueError(
+            f"{model.__name__}: locate_impacts needs a model with contacts and without brakes "
+            f"(it has {c} contacts, {k} brakes)"
         )
     gaps = eq.gaps
     contact_rows, brake_rows = eq.contact_rows, eq.brake_rows
@@ -258,7 +272,7 @@ def make_step_kernels(
         """
         (qm, M, Minv, h, B, ufree, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree, gpre, S, s0,
          A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P, Mwork,
-         col, row_eps) = fs
+         col, row_eps, _, _, _, _, _) = fs
         basis, row_of, slot_of, slot_var, row_ref, row_var, mass_ready = js
         motion = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
         ok = motion != MOTION_SINGULAR
@@ -415,10 +429,70 @@ def make_step_kernels(
             q_out[j] = qm[j] + 0.5 * dt * acc
 
     @njit
+    def located_advance(q, u, tau, brake_bound, dt, p, q_out, u_out,  # noqa: ANN001
+                        impulses, info, fs, js):
+        """``advance``, but a step in which an open contact closes is split at the impact.
+
+        The parts: flight to t*, the impact law alone (a step of length 0), the rest.
+
+        The midpoint step applies an impact at the step's midpoint wherever in the step it
+        happened, an O(|u| dt) error in position and O(|h| dt) in velocity per impact. Here
+        t* is the first root in (0, dt] of the gap's quadratic model g(t_k + s) = g0 + s
+        gamma0 + s^2 (gamma_free - gamma0) / (2 dt) (gamma = W_N^T u at the step start and
+        after the free motion), exact for constant forces and linear gaps (the bouncing
+        ball). Only the first impact of a step is located; a contact the model leaves open
+        at t* (curved gaps: g(q(t*)) of order dt^3) is taken by the last part's midpoint as
+        usual. Outputs as ``advance``: impulses summed over the parts, the worst status, the
+        iterations summed, the other diagnostics of the part that closed the most contacts.
+        """
+        Wc, ufree = fs[7], fs[5]
+        g0, q_hit, u_hit, part_impulses, part_info = fs[-5], fs[-4], fs[-3], fs[-2], fs[-1]
+        advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fs, js)
+        gaps(q, p, g0)
+        hit = dt
+        for i in range(c):
+            if g0[i] <= GAP_TOLERANCE:
+                continue
+            gamma0 = 0.0
+            gamma_free = 0.0
+            for j in range(n):
+                gamma0 += Wc[i * d, j] * u[j]
+                gamma_free += Wc[i * d, j] * ufree[j]
+            if g0[i] + 0.5 * dt * (gamma0 + gamma_free) > 0.0:
+                continue  # still open at t_k + dt
+            hit = min(hit, _first_root(g0[i], gamma0, 0.5 * (gamma_free - gamma0) / dt, dt))
+        if hit >= dt:
+            return
+        for part in range(3):
+            length = hit if part == 0 else 0.0 if part == 1 else dt - hit
+            q_from = q if part == 0 else q_out
+            u_from = u if part == 0 else u_out
+            advance(q_from, u_from, tau, brake_bound, length, p, q_hit, u_hit, part_impulses,
+                    part_info, fs, js)
+            for j in range(n):
+                q_out[j] = q_hit[j]
+                u_out[j] = u_hit[j]
+            if part == 0:
+                for r in range(c * d):
+                    impulses[r] = part_impulses[r]
+                for r in range(INFO_SIZE):
+                    info[r] = part_info[r]
+                continue
+            for r in range(c * d):
+                impulses[r] += part_impulses[r]
+            info[INFO_STATUS] = max(info[INFO_STATUS], part_info[INFO_STATUS])
+            info[INFO_ITERATIONS] += part_info[INFO_ITERATIONS]
+            if part_info[INFO_ACTIVE_CONTACTS] > info[INFO_ACTIVE_CONTACTS]:
+                for r in range(INFO_ACTIVE_CONTACTS, INFO_SIZE):
+                    info[r] = part_info[r]
+
+    step_once = located_advance if locate_impacts else advance
+
+    @njit
     def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
         """One step (arguments as ``advance``; ws = ``make_workspace(model)``)."""
-        advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info,
-                carve_floats(ws[0]), carve_ints(ws[1]))
+        step_once(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info,
+                  carve_floats(ws[0]), carve_ints(ws[1]))
 
     @njit
     def step_batch(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, ws):  # noqa: ANN001
@@ -440,8 +514,8 @@ def make_step_kernels(
         for e in range(num_copies):
             worst = 0.0
             for _ in range(num_substeps):
-                advance(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e],
-                        INFO[e], fs, js)
+                step_once(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e],
+                          INFO[e], fs, js)
                 for j in range(n):
                     Q[e, j] = q_next[j]
                     U[e, j] = u_next[j]
@@ -450,6 +524,28 @@ def make_step_kernels(
             INFO[e, INFO_STATUS] = worst
 
     return step, step_batch
+
+
+@njit(cache=True)
+def _first_root(c0: float, c1: float, c2: float, limit: float) -> float:
+    """The smallest root s in (0, limit] of c0 + c1 s + c2 s^2.
+
+    Given c0 > 0 >= the value at ``limit`` (so one exists); the secant's root when rounding
+    hides it.
+    """
+    if c2 != 0.0:
+        discriminant = c1 * c1 - 4.0 * c2 * c0
+        if discriminant >= 0.0:
+            half = -0.5 * (c1 + np.copysign(np.sqrt(discriminant), c1))  # != 0 as c0 > 0
+            best = np.inf
+            for root in (half / c2, c0 / half):
+                if 0.0 < root <= limit and root < best:
+                    best = root
+            if best <= limit:
+                return best
+    elif c1 < 0.0:
+        return min(limit, -c0 / c1)
+    return limit * c0 / (c0 - (c0 + limit * (c1 + limit * c2)))
 
 
 @njit(cache=True)

@@ -37,7 +37,7 @@ from mdi_envs.stepping._spatial_kernel import (
     make_spatial_workspace,
 )
 
-_KERNELS: dict[tuple[type[ModelDefinition], StepShortcuts], tuple[Any, Any]] = {}
+_KERNELS: dict[tuple[type[ModelDefinition], StepShortcuts, bool], tuple[Any, Any]] = {}
 
 
 class StepResult(NamedTuple):
@@ -77,6 +77,11 @@ class MoreauJeanStepper:
         parameters: its parameter dataclass instance (default: ``model.Parameters()``).
         time_step: dt [s], > 0.
         shortcuts: which exact shortcuts to take (default: all; see ``StepShortcuts``).
+        locate_impacts: split a step in which a contact closes at the impact time (flight,
+            impact law, rest of the step) instead of applying the impact at the step's
+            midpoint: isolated impacts then cost O(dt^3) instead of O(dt) (a bouncing ball's
+            apexes exact to rounding), at up to 3 extra solves per impact step. Off by default
+            (DESIGN.md's scheme); models with contacts and without brakes only.
 
     Example:
         >>> from mdi_envs.mechanics.models.bouncing_ball import BouncingBall
@@ -90,6 +95,7 @@ class MoreauJeanStepper:
     parameters: Any = None
     time_step: float = 1e-3
     shortcuts: StepShortcuts = StepShortcuts()
+    locate_impacts: bool = False
     num_dofs: int = field(init=False)
     num_inputs: int = field(init=False)
     num_brakes: int = field(init=False)
@@ -114,13 +120,22 @@ class MoreauJeanStepper:
                 f"got {type(self.parameters).__name__}"
             )
         self._values = self.parameters.values()
-        key = (self.model, self.shortcuts)
+        key = (self.model, self.shortcuts, bool(self.locate_impacts))
         spatial = self.model.CONTACT_DIMENSION == 3 and self.model.NUM_CONTACTS > 0
-        if key not in _KERNELS:
-            make_kernels = make_spatial_step_kernels if spatial else make_step_kernels
-            _KERNELS[key] = make_kernels(
-                self.model, compile_equations(self.model), self.shortcuts
+        if self.locate_impacts and (spatial or self.model.NUM_CONTACTS == 0
+                                    or self.model.NUM_BRAKES > 0):
+            raise ValueError(
+                f"locate_impacts needs a model with planar contacts and without brakes; "
+                f"{self.model.__name__} has {self.model.NUM_CONTACTS} contacts of dimension "
+                f"{self.model.CONTACT_DIMENSION} and {self.model.NUM_BRAKES} brakes"
             )
+        if key not in _KERNELS:
+            equations = compile_equations(self.model)
+            _KERNELS[key] = (
+                make_spatial_step_kernels(self.model, equations, self.shortcuts) if spatial
+                else make_step_kernels(self.model, equations, self.shortcuts,
+                                       self.locate_impacts)
+            )  # fmt: skip
         self._step, self._step_batch = _KERNELS[key]
         if spatial:
             self._workspace = make_spatial_workspace(self.model)
@@ -141,7 +156,8 @@ class MoreauJeanStepper:
         Compiled kernels and scratch arrays are rebuilt on loading; the spatial step's warm
         start is not carried over.
         """
-        return (type(self), (self.model, self.parameters, self.time_step, self.shortcuts))
+        return (type(self), (self.model, self.parameters, self.time_step, self.shortcuts,
+                             self.locate_impacts))  # fmt: skip
 
     @property
     def compiled_step_batch(self) -> tuple[Any, Any, Any]:

@@ -62,7 +62,8 @@ def test_outputs_exist_and_are_consistent(quick: tuple[Path, dict[str, Any]]) ->
     series = {(p["scene"], p["series"]) for p in record["points"]}
     assert {("ball", "mj_enumerative"), ("ball", "event_driven"),
             ("manipulator", "mj_enumerative"), ("manipulator", "event_driven")} <= series
-    assert [t["met"] for t in record["targets"]][3] is None  # no brake-stop study in --quick
+    brake = [t for t in record["targets"] if t["target"].startswith("brake stops")]
+    assert len(brake) == 1 and brake[0]["met"] is None  # no brake-stop study in --quick
     report = wpr.markdown_report(record)
     assert "**Targets**" in report and "| target | threshold |" in report
     assert "Bouncing ball" in report and "Manipulator" in report
@@ -79,18 +80,23 @@ def test_ball_error_converges_at_first_order(quick: tuple[Path, dict[str, Any]])
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "target not met (reported): the mean over 8 drops of the largest relative apex error "
-        "over bounces 1-3 is 2.55e-3 at dt = 1e-3 s (worst drop 5.1e-3; per bounce 6.9e-4, "
-        "1.2e-3, 2.5e-3): the impact is applied at the step's midpoint, an O(v dt) error"
-    ),
-)
-def test_ball_apex_error_at_1ms_meets_target(quick: tuple[Path, dict[str, Any]]) -> None:
-    """Issue 7: "ball apex error <= 1e-3 relative at dt = 1e-3"."""
-    at_1ms = [p for p in ball_points(quick[1], "mj_enumerative") if p["value"] == 1e-3][0]
+def test_ball_apex_error_at_1ms_meets_target_with_located_impacts(
+    quick: tuple[Path, dict[str, Any]],
+) -> None:
+    """Issue 7: "ball apex error <= 1e-3 relative at dt = 1e-3", converging at least O(dt).
+
+    Met by ``locate_impacts=True`` (what remains is the grid's sampling of each apex, ~g dt^2/8);
+    the default midpoint step's O(|v| dt) error (~2.5e-3) is reported beside it, not judged.
+    """
+    located = ball_points(quick[1], "mj_located")
+    at_1ms = [p for p in located if p["value"] == 1e-3][0]
     assert at_1ms["error"] <= wp.TARGET_APEX_ERROR
+    default = [p for p in ball_points(quick[1], "mj_enumerative") if p["value"] == 1e-3][0]
+    assert at_1ms["error"] < 0.01 * default["error"]
+    order = wp.observed_order(located)
+    assert order is not None and order >= wp.TARGET_ORDER
+    apex_rows = [t["met"] for t in quick[1]["targets"] if t["target"].startswith("ball apex")]
+    assert apex_rows == [True, False]  # located, default
 
 
 @pytest.mark.slow
@@ -140,7 +146,7 @@ def test_main_returns_zero_and_prints_the_report(
         return records[len(calls) - 1]
 
     monkeypatch.setattr(wp, "run", fake_run)
-    assert any(t["met"] is False for t in quick[1]["targets"])  # the apex target is missed
+    assert any(t["met"] is False for t in quick[1]["targets"])  # the default's apex error
     assert wp.main(["--quick", "--output", "somewhere"]) == 0
     assert calls == [(Path("somewhere"), True)]
     assert "**Targets**" in capsys.readouterr().out
