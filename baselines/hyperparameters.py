@@ -6,29 +6,33 @@ flattened Box action spaces, and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO wi
 brake x Gaussian torque policy) on the manipulator's native ``action_mode="hybrid"`` space
 ``Tuple(Discrete(2), Box(-1, 1, (1,)))``. Choices shared by every entry:
 
-- ``gamma = 0.99`` for every algorithm, passed to the env as ``shaping_discount`` (the shaping
-  term gamma Phi(s') - Phi(s) then leaves the optimal policy unchanged; ``train`` sets it),
-  except where an entry fixes ``shaping_discount = 1.0``: the diff drive's "time" PPO and
-  HybridPPO (whose gamma-shaped run learned to hold the arm still). With
-  Phi = -distance and gamma < 1 the shaping pays (1 - gamma) * distance per step for standing
-  still, and the gamma-shaped robot runs settled there (0 % success at 5 x 10^6 steps); with
-  1.0 the shaping telescopes to Phi(s_T) - Phi(s_0) per episode, so the episodic (undiscounted)
-  objective is unchanged and the same settings reached 100 % success at 4 x 10^6 steps.
+- ``gamma = 0.99`` for every algorithm. The env's shaping term is
+  ``shaping_discount * Phi(s') - Phi(s)`` with Phi = -distance; every entry sets
+  ``shaping_discount = 1.0`` (``SHAPING_DISCOUNT``) except the manipulator's PPO, shipped with
+  0.99 = gamma. With 1.0 the shaping telescopes to Phi(s_T) - Phi(s_0) per episode, so the
+  episodic (undiscounted) objective is unchanged; with gamma < 1 it pays (1 - gamma) * distance
+  per step for standing still, and the gamma-shaped HybridPPO and robot "time" runs settled
+  there (0 % success at 5 x 10^6 steps) where the same settings with 1.0 reached 100 %.
+- Diff drive "effort": ``goal_weight = 100`` (the weight of the distance at the horizon's
+  end). With the env's default 10 the 5 x 10^6-step PPO stopped ~0.3 m short using 0.43 of
+  the optimum's effort; with 100 it stops 0.06-0.07 m short (effort 1.27x the optimum), still
+  0 % success as the tolerance is 0.05 m; with 1000 the returns (down to -10^4) swamped the
+  unnormalized value function and it ended 1.7 m away.
 - PPO with many copies (64): the batched env steps them in one compiled call, so a rollout of
   64 x 256 = 16384 steps costs about as much as a few hundred single-env steps; minibatches
   of 2048, 10 epochs, GAE lambda 0.95, clip 0.2, no entropy bonus, 2 x 64 tanh MLPs (SB3's
   defaults otherwise, as in rl-zoo's continuous-control settings).
 - HybridPPO: exactly the PPO settings (no per-algorithm tuning), only the action space differs.
-- SAC with fewer copies (8) and ``gradient_steps = num_envs`` (one gradient step per env
-  transition, SAC's usual replay ratio), 10^6 buffer, batch 256, 2 x 256 ReLU MLPs, automatic
-  entropy tuning, 10^4 random warm-up steps.
+- SAC with 64 copies and 4 gradient steps per 64 transitions (replay ratio 1/16, far below
+  SAC's usual 1): a gradient step costs ~12-25 ms on this CPU whatever the width (overhead-
+  bound), so the usual ratio would give ~50 transitions/s; 10^6 buffer, batch 256, 2 x 256 ReLU
+  MLPs, automatic entropy tuning, 10^4 random warm-up steps.
 - Budgets, the ones of the shipped policies (``baselines/trained``): PPO 10^7 steps on the
   manipulator, 4 x 10^6 on diff drive "time", 5 x 10^6 on "effort", HybridPPO 5 x 10^6,
-  SAC 2 x 10^5 (what
-  fitted one session on the 2-core machine: PPO runs at about 3-15 k steps/s there, SAC at a
-  few hundred). Episodes: manipulator up to 500 steps of 0.02 s, the optimum takes about 228;
-  diff drive "time" up to 200 steps of 0.05 s, "effort" exactly 81. Untuned starting points:
-  the shipped results say how far they get.
+  SAC 10^6 (what fitted one session on the 2-core machine: PPO runs at about 3-15 k steps/s
+  there, SAC at about 1 k). Episodes: manipulator up to 500 steps of 0.02 s, the optimum
+  takes about 228; diff drive "time" up to 200 steps of 0.05 s, "effort" exactly 81.
+  Untuned starting points: the shipped results say how far they get.
 - Seed 0 everywhere; ``train(..., seed=...)`` overrides it.
 """
 
@@ -60,36 +64,39 @@ _PPO: dict[str, Any] = {
     },
 }
 _SAC: dict[str, Any] = {
-    "num_envs": 8,
+    "num_envs": 64,
     "seed": 0,
     "algo_kwargs": {
         "buffer_size": 1_000_000, "batch_size": 256, "learning_rate": 3e-4, "gamma": 0.99,
-        "tau": 0.005, "learning_starts": 10_000, "train_freq": 1, "gradient_steps": 8,
+        "tau": 0.005, "learning_starts": 10_000, "train_freq": 1, "gradient_steps": 4,
         "ent_coef": "auto", "policy_kwargs": {"net_arch": [256, 256]},
     },
 }
 
 
+SHAPING_DISCOUNT = 1.0
+"""The env's ``shaping_discount`` in every entry that does not set its own."""
+
+
 def _entry(base: dict[str, Any], env_kwargs: dict[str, Any], total_timesteps: int
            ) -> dict[str, Any]:  # fmt: skip
-    return {**copy.deepcopy(base), "env_kwargs": dict(env_kwargs),
-            "total_timesteps": total_timesteps}  # fmt: skip
+    return {**copy.deepcopy(base), "total_timesteps": total_timesteps,
+            "env_kwargs": {"shaping_discount": SHAPING_DISCOUNT, **env_kwargs}}  # fmt: skip
 
 
 HYPERPARAMETERS: dict[tuple[str, str, str], dict[str, Any]] = {
-    (MANIPULATOR, "time", "PPO"): _entry(_PPO, {}, 10_000_000),
-    (MANIPULATOR, "time", "SAC"): _entry(_SAC, {}, 200_000),
-    (MANIPULATOR, "time", "HybridPPO"): _entry(
-        _PPO, {"action_mode": "hybrid", "shaping_discount": 1.0}, 5_000_000),
-    (DIFF_DRIVE, "time", "PPO"): _entry(_PPO, {"task": "time", "shaping_discount": 1.0},
-                                        4_000_000),
-    (DIFF_DRIVE, "time", "SAC"): _entry(_SAC, {"task": "time"}, 200_000),
-    (DIFF_DRIVE, "effort", "PPO"): _entry(_PPO, {"task": "effort"}, 5_000_000),
-    (DIFF_DRIVE, "effort", "SAC"): _entry(_SAC, {"task": "effort"}, 200_000),
+    (MANIPULATOR, "time", "PPO"): _entry(_PPO, {"shaping_discount": 0.99}, 10_000_000),
+    (MANIPULATOR, "time", "SAC"): _entry(_SAC, {}, 1_000_000),
+    (MANIPULATOR, "time", "HybridPPO"): _entry(_PPO, {"action_mode": "hybrid"}, 5_000_000),
+    (DIFF_DRIVE, "time", "PPO"): _entry(_PPO, {"task": "time"}, 4_000_000),
+    (DIFF_DRIVE, "time", "SAC"): _entry(_SAC, {"task": "time"}, 1_000_000),
+    (DIFF_DRIVE, "effort", "PPO"): _entry(_PPO, {"task": "effort", "goal_weight": 100.0},
+                                          5_000_000),
+    (DIFF_DRIVE, "effort", "SAC"): _entry(_SAC, {"task": "effort", "goal_weight": 100.0},
+                                          1_000_000),
 }
 """(env id, task, algorithm) -> {"num_envs", "total_timesteps", "seed", "algo_kwargs" (SB3
-constructor arguments), "env_kwargs" (``gym.make`` arguments; ``shaping_discount`` is added
-from gamma)}."""
+constructor arguments), "env_kwargs" (``gym.make`` arguments)}."""
 
 DEFAULT_TASKS = {MANIPULATOR: "time", DIFF_DRIVE: "time"}
 """The task used when none is given (the manipulator has only "time")."""
@@ -104,7 +111,7 @@ def canonical_algorithm(name: str) -> str:
 
 
 def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict[str, Any]:
-    """A deep copy of the table entry; ``env_kwargs["shaping_discount"]`` = gamma unless set.
+    """A deep copy of the table entry.
 
     Args:
         env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
@@ -119,12 +126,11 @@ def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict
     if key not in HYPERPARAMETERS:
         known = ", ".join(" ".join(k) for k in HYPERPARAMETERS)
         raise KeyError(f"no hyperparameters for {' '.join(map(str, key))}; known: {known}")
-    entry = copy.deepcopy(HYPERPARAMETERS[key])
-    entry["env_kwargs"].setdefault("shaping_discount", entry["algo_kwargs"]["gamma"])
-    return entry
+    return copy.deepcopy(HYPERPARAMETERS[key])
 
 
 __all__ = [
-    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_TASKS", "HYPERPARAMETERS", "canonical_algorithm",
+    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_TASKS", "HYPERPARAMETERS", "SHAPING_DISCOUNT",
+    "canonical_algorithm",
     "get_hyperparameters",
 ]

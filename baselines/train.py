@@ -43,7 +43,6 @@ from stable_baselines3.common.callbacks import BaseCallback
 import mdi_envs
 from baselines.hyperparameters import (
     ALGORITHM_CLASSES,
-    HYPERPARAMETERS,
     canonical_algorithm,
     get_hyperparameters,
 )
@@ -160,9 +159,7 @@ def train(
     total_timesteps = entry["total_timesteps"] if total_timesteps is None else total_timesteps
     num_envs = entry["num_envs"] if num_envs is None else int(num_envs)
     algo_kwargs = {**entry["algo_kwargs"], **(algo_overrides or {})}
-    env_kwargs = dict(entry["env_kwargs"])
-    if "shaping_discount" not in HYPERPARAMETERS[(env_id, task, algo)]["env_kwargs"]:
-        env_kwargs["shaping_discount"] = algo_kwargs["gamma"]  # follows an overridden gamma
+    env_kwargs = entry["env_kwargs"]
     if progress_bar is None:
         progress_bar = sys.stderr.isatty()
     output = Path(output)

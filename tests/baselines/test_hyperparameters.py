@@ -10,6 +10,7 @@ from baselines.hyperparameters import (
     ALGORITHM_CLASSES,
     ALGORITHMS,
     HYPERPARAMETERS,
+    SHAPING_DISCOUNT,
     canonical_algorithm,
     get_hyperparameters,
 )
@@ -24,14 +25,17 @@ def test_table_covers_both_envs_tasks_and_algorithms() -> None:
         assert entry["algo_kwargs"]["gamma"] == 0.99
 
 
-def test_get_hyperparameters_sets_the_shaping_discount_and_copies() -> None:
+def test_every_entry_fixes_the_shaping_discount_and_lookups_copy() -> None:
+    for key, entry in HYPERPARAMETERS.items():
+        expected = 0.99 if key == ("mdi_envs/BlockableManipulator-v0", "time", "PPO") else 1.0
+        assert entry["env_kwargs"]["shaping_discount"] == expected, key
     entry = get_hyperparameters("mdi_envs/DiffDriveRobot-v0", "sac", "effort")
-    assert entry["env_kwargs"] == {"task": "effort", "shaping_discount": 0.99}
+    assert entry["env_kwargs"] == {"task": "effort", "goal_weight": 100.0,
+                                   "shaping_discount": SHAPING_DISCOUNT}  # fmt: skip
     entry["algo_kwargs"]["gamma"] = 0.5
-    assert HYPERPARAMETERS[("mdi_envs/DiffDriveRobot-v0", "effort", "SAC")]["algo_kwargs"][
-        "gamma"] == 0.99
-    assert get_hyperparameters("mdi_envs/BlockableManipulator-v0", "PPO")["env_kwargs"] == {
-        "shaping_discount": 0.99}
+    entry["env_kwargs"]["goal_weight"] = 1.0
+    fresh = get_hyperparameters("mdi_envs/DiffDriveRobot-v0", "SAC", "effort")
+    assert fresh["algo_kwargs"]["gamma"] == 0.99 and fresh["env_kwargs"]["goal_weight"] == 100.0
     with pytest.raises(KeyError, match="known"):
         get_hyperparameters("mdi_envs/BlockableManipulator-v0", "PPO", "effort")
 
@@ -39,8 +43,7 @@ def test_get_hyperparameters_sets_the_shaping_discount_and_copies() -> None:
 def test_hybrid_ppo_uses_the_ppo_settings_on_the_hybrid_space() -> None:
     hybrid = get_hyperparameters("mdi_envs/BlockableManipulator-v0", "hybridppo")
     ppo = get_hyperparameters("mdi_envs/BlockableManipulator-v0", "ppo")
-    assert hybrid["env_kwargs"] == {**ppo["env_kwargs"], "action_mode": "hybrid",
-                                    "shaping_discount": 1.0}  # fmt: skip
+    assert hybrid["env_kwargs"] == {"action_mode": "hybrid", "shaping_discount": 1.0}
     same = ("num_envs", "seed", "algo_kwargs")  # the budgets differ (10^7 vs 5 x 10^6)
     assert {k: hybrid[k] for k in same} == {k: ppo[k] for k in same}
     assert [canonical_algorithm(a) for a in ("sac", "HYBRIDPPO", "dqn")] == [

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from baselines.cli import add_train_parser
+from baselines.hyperparameters import get_hyperparameters
 from baselines.train import plot_training, run_name
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
@@ -29,7 +30,7 @@ def _check_outputs(model_path: Path, algo: str, num_timesteps: int) -> dict:
     config = json.loads(model_path.with_suffix(".json").read_text())
     assert config["algo"] == algo and config["seed"] == 3
     assert config["num_timesteps"] >= num_timesteps
-    assert config["env_kwargs"]["shaping_discount"] == config["algo_kwargs"]["gamma"]
+    assert config["env_kwargs"] == get_hyperparameters(MANIPULATOR, algo)["env_kwargs"]
     assert config["algo_kwargs"]["policy_kwargs"] == TINY["policy_kwargs"]  # not SB3's copy
     assert {"stable_baselines3", "torch", "gymnasium", "mdi_envs"} <= set(config["versions"])
     assert config["num_episodes"] >= 1  # 500-step manipulator episodes end within the budget
