@@ -79,9 +79,12 @@ class MoreauJeanStepper:
         shortcuts: which exact shortcuts to take (default: all; see ``StepShortcuts``).
         locate_impacts: split a step in which a contact closes at the impact time (flight,
             impact law, rest of the step) instead of applying the impact at the step's
-            midpoint: isolated impacts then cost O(dt^3) instead of O(dt) (a bouncing ball's
-            apexes exact to rounding), at up to 3 extra solves per impact step. Off by default
-            (DESIGN.md's scheme); models with contacts and without brakes only.
+            midpoint, an O(|u| dt) error per impact. The impact time is the root of the gap's
+            quadratic model over the step: exact for linear gaps under constant forces (the
+            ball and the block: grid states equal the closed form to rounding); a contact the
+            model leaves open at t* falls back to the midpoint rule. Up to 3 extra solves per
+            impact step. Off by default (DESIGN.md's scheme); models with contacts and without
+            brakes only.
 
     Example:
         >>> from mdi_envs.mechanics.models.bouncing_ball import BouncingBall
