@@ -29,6 +29,8 @@ def add_optimize_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument("--output", type=Path, default=Path("results/optimal"),
                         help="folder for NAME.npz, NAME.json and the PNGs")
     parser.add_argument("--intervals", type=int, default=None, help="N (default: the problem's)")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="processes for a multi-start's starts (default: one per core)")
     parser.add_argument("--install", action="store_true",
                         help="also write the reference into optimal/references (package data), "
                         "if it converged and its replay reaches the goal")
@@ -42,12 +44,14 @@ def run_optimize(args: argparse.Namespace) -> int:
     from optimal.references import REFERENCE_DIR, save_reference
     from optimal.solve import solve_problem
 
-    reference = solve_problem(args.name, args.intervals, progress=lambda line: print(line,
-                                                                                     flush=True))
+    reference = solve_problem(args.name, args.intervals, workers=args.workers,
+                              progress=lambda line: print(line, flush=True))
     meta = reference.metadata
     path = save_reference(reference, args.output)
     print(f"{args.name}: t_f = {meta['final_time']:.4f} s, cost = {meta['cost']:.6g}, "
-          f"solve time {meta['solve_time']:.1f} s, converged: {meta['converged']}")
+          f"solve time {meta['total_time']:.1f} s wall ({meta['solve_time']:.1f} s of IPOPT "
+          f"over {len(meta['starts'])} start(s), {meta['workers']} process(es)), "
+          f"converged: {meta['converged']}")
     print(f"saved {path} and {path.with_suffix('.npz')}")
     for png in plot_reference(reference, args.output):
         print(f"saved {png}")
