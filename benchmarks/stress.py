@@ -41,6 +41,7 @@ radius 0), and it skips the differential-drive robot's cases.
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -153,10 +154,16 @@ class Steppers:
     log: Callable[[str], None]
     compile_s: dict[str, float] = field(default_factory=dict)
 
-    def get(self, label: str, time_step: float, **parameters: Any) -> MoreauJeanStepper:
-        """A stepper of model ``label`` with ``parameters`` (compiled on the model's first use)."""
+    def get(self, label: str, time_step: float, locate_impacts: bool = False,
+            **parameters: Any) -> MoreauJeanStepper:
+        """A stepper of model ``label`` with ``parameters``, compiled on the kernel's first use.
+
+        ``locate_impacts`` steppers have kernels of their own, timed as ``label + " located"``.
+        """
         model = MODELS[label]
-        stepper = MoreauJeanStepper(model, model.Parameters(**parameters), time_step)
+        stepper = MoreauJeanStepper(model, model.Parameters(**parameters), time_step,
+                                    locate_impacts=locate_impacts)  # fmt: skip
+        label = label + (" located" if locate_impacts else "")
         if label not in self.compile_s:
             self.log(f"compiling {label} (first step_batch) ...")
             start = time.perf_counter()
@@ -420,6 +427,8 @@ def zeno_cases(config: StressConfig, steppers: Steppers, log: Callable[[str], No
                ) -> list[dict[str, Any]]:  # fmt: skip
     """Balls dropped from rest, one batch copy per drop height, for each eps; dt = 1e-3 s.
 
+    Each eps runs with the default midpoint step and with ``locate_impacts=True`` ("located").
+
     Closed forms (v1 = sqrt(2 g h0)): first impact t1 = sqrt(2 h0 / g), rest at the Zeno time
     t_inf = t1 (1 + eps) / (1 - eps). Criteria:
 
@@ -445,12 +454,12 @@ def zeno_cases(config: StressConfig, steppers: Steppers, log: Callable[[str], No
     label = "ball" if "ball" in config.models else "block"
     cases = []
     heights = np.array(config.zeno_heights)
-    for eps in config.zeno_restitutions:
+    for eps, located in itertools.product(config.zeno_restitutions, (False, True)):
         if label == "ball":
-            st = steppers.get("ball", BALL_TIME_STEP, restitution=eps)
+            st = steppers.get("ball", BALL_TIME_STEP, located, restitution=eps)
         else:
-            st = steppers.get("block", BALL_TIME_STEP, slope_angle=0.0, restitution=eps,
-                              friction_coefficient=0.0)
+            st = steppers.get("block", BALL_TIME_STEP, located, slope_angle=0.0,
+                              restitution=eps, friction_coefficient=0.0)
         start = time.perf_counter()
         p, dt = st.parameters, BALL_TIME_STEP
         g, m = p.gravity, p.mass
@@ -508,10 +517,11 @@ def zeno_cases(config: StressConfig, steppers: Steppers, log: Callable[[str], No
             criteria["energy_decay"] = at_most((energy[-1] / expected).max(), 1.0)
             metrics["closed_form_impacts"] = impacts.tolist()
             metrics["final_energy_ratio"] = (energy[-1] / e0).tolist()
-        name = f"zeno {label} eps={eps:g}"
+        name = f"zeno {label} eps={eps:g}" + (" located" if located else "")
         cases.append(case_record(
             "zeno", name,
-            {"model": label, "eps": eps, "dt": dt, "steps": total, "heights_m": heights.tolist()},
+            {"model": label, "eps": eps, "dt": dt, "steps": total, "heights_m": heights.tolist(),
+             "locate_impacts": located},
             metrics, criteria,
             "" if label == "ball" else "point mass on the block's slope set flat (quick mode)"))
         log(f"{name}: {'PASS' if cases[-1]['passed'] else 'FAIL'} "

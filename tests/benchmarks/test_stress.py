@@ -57,7 +57,8 @@ def test_every_family_is_run(outcome: tuple[dict[str, Any], Path]) -> None:
     assert families == {"zeno", "brake_toggle", "dt_sweep", "mu_sweep", "overdrive", "lcp",
                         "long_horizon"}
     zeno = [c for c in record["cases"] if c["family"] == "zeno"]
-    assert [c["parameters"]["eps"] for c in zeno] == [0.0, 0.3, 0.6, 0.9, 0.99]
+    assert [(c["parameters"]["eps"], c["parameters"]["locate_impacts"]) for c in zeno] == [
+        (eps, located) for eps in (0.0, 0.3, 0.6, 0.9, 0.99) for located in (False, True)]
     dts = {c["parameters"]["dt"] for c in record["cases"] if c["family"] == "dt_sweep"}
     assert min(dts) == 1e-6 and max(dts) == 0.1
 
