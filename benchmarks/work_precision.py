@@ -833,8 +833,8 @@ def evaluate_targets(points: Sequence[dict[str, Any]], brake: dict[str, Any] | N
         note = "" if apex is None else f"worst drop {apex['error_max']:.2e}; per bounce " + \
             ", ".join(f"{x:.2e}" for x in apex["apex_error_by_bounce"])
         if default:
-            note = "the impact applied at the step's midpoint, an O(|v| dt) error" + (
-                f"; {note}" if note else "")
+            note = ("the impact applied at the step's midpoint, an O(v dt) error, v the impact "
+                    "speed") + (f"; {note}" if note else "")
         targets.append(R.target_row(
             f"ball apex error at dt = 1e-3 s (relative, bounces 1-3, mean over drops), {label}",
             f"≤ {TARGET_APEX_ERROR:g}", None if apex is None else apex["error"],

@@ -86,7 +86,7 @@ def test_ball_apex_error_at_1ms_meets_target_with_located_impacts(
     """Issue 7: "ball apex error <= 1e-3 relative at dt = 1e-3", converging at least O(dt).
 
     Met by ``locate_impacts=True`` (what remains is the grid's sampling of each apex, ~g dt^2/8);
-    the default midpoint step's O(|v| dt) error (~2.5e-3) is reported beside it, not judged.
+    the default midpoint step's O(v dt) error (~2.5e-3) is reported beside it as not met.
     """
     located = ball_points(quick[1], "mj_located")
     at_1ms = [p for p in located if p["value"] == 1e-3][0]
