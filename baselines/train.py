@@ -2,7 +2,8 @@
 
 ``train("mdi_envs/DiffDriveRobot-v0", "PPO", task="effort", output=Path("results/baselines"))``
 checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched env through the
-``MoreauJeanVecEnv`` adapter wrapped in ``VecMonitor``, trains with the table's settings
+``MoreauJeanVecEnv`` adapter wrapped in ``VecMonitor`` (and, for entries with
+``normalize_reward``, in ``VecNormalize`` on the rewards only), trains with the table's settings
 (``baselines.hyperparameters``), logs to TensorBoard, evaluates the deterministic policy with
 ``evaluate_policy`` on ``gym.make`` copies, and writes into ``output``:
 
@@ -147,7 +148,7 @@ def train(
             2-core machine two threads made a PPO run about 20x slower.
     """
     import torch
-    from stable_baselines3.common.vec_env import VecMonitor
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     from baselines.vec_env import make_vec_env
 
@@ -168,6 +169,8 @@ def train(
 
     check_single_env(env_id, env_kwargs)
     venv = VecMonitor(make_vec_env(env_id, num_envs, **env_kwargs))
+    if entry["normalize_reward"]:  # training only: the policy never sees the scaled rewards
+        venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=algo_kwargs["gamma"])
     model_class = algorithm_class(algo)
     model = model_class("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose,
                         tensorboard_log=str(output / "tensorboard"),
@@ -187,6 +190,7 @@ def train(
     config = {
         "env_id": env_id, "task": task, "algo": algo, "seed": seed,
         "num_envs": num_envs, "total_timesteps": total_timesteps,
+        "normalize_reward": entry["normalize_reward"],
         "num_timesteps": int(model.num_timesteps),
         "algo_kwargs": algo_kwargs, "algo_overrides": algo_overrides or {},
         "env_kwargs": env_kwargs, "policy": "MlpPolicy",

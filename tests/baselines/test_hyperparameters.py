@@ -20,7 +20,9 @@ def test_table_covers_both_envs_tasks_and_algorithms() -> None:
     assert len(HYPERPARAMETERS) == 7 and set(ALGORITHM_CLASSES) == set(ALGORITHMS)
     for (env_id, task, algo), entry in HYPERPARAMETERS.items():
         assert env_id in gym.registry and algo in ALGORITHMS and task in ("time", "effort")
-        assert {"num_envs", "total_timesteps", "seed", "algo_kwargs", "env_kwargs"} <= set(entry)
+        assert {"num_envs", "total_timesteps", "seed", "algo_kwargs", "env_kwargs",
+                "normalize_reward"} <= set(entry)
+        assert isinstance(entry["normalize_reward"], bool)
         assert isinstance(entry["seed"], int) and entry["num_envs"] >= 1
         assert entry["algo_kwargs"]["gamma"] == 0.99
 
@@ -69,3 +71,4 @@ def test_shipped_policies_were_trained_with_the_table() -> None:
         assert config["seed"] == entry["seed"], path.name
         assert config["algo_kwargs"] == entry["algo_kwargs"], path.name
         assert config["env_kwargs"] == entry["env_kwargs"], path.name
+        assert config.get("normalize_reward", False) == entry["normalize_reward"], path.name

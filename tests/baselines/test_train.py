@@ -42,16 +42,23 @@ def _check_outputs(model_path: Path, algo: str, num_timesteps: int) -> dict:
 
 
 @pytest.mark.slow
-def test_train_ppo_smoke(tmp_path: Path) -> None:
+def test_train_ppo_smoke_with_normalized_rewards(tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     from stable_baselines3 import PPO
 
+    import baselines.hyperparameters as table
     from baselines.train import train
 
+    monkeypatch.setitem(table.HYPERPARAMETERS[(MANIPULATOR, "time", "PPO")],
+                        "normalize_reward", True)  # fmt: skip
     overrides = {"n_steps": 64, "batch_size": 64, "n_epochs": 2, **TINY}
     path = train(MANIPULATOR, "ppo", seed=3, total_timesteps=1000, output=tmp_path,
                  num_envs=2, algo_overrides=overrides, eval_episodes=1, progress_bar=False)
     assert path == tmp_path / f"{run_name(MANIPULATOR, 'time', 'PPO', 3)}.zip"
-    _check_outputs(path, "PPO", 1000)
+    config = _check_outputs(path, "PPO", 1000)
+    assert config["normalize_reward"] is True
+    # VecMonitor sits below VecNormalize: the logged returns are the env's own
+    assert np.isfinite(config["train_last100"]["mean_return"])
     model = PPO.load(path, device="cpu")
     action, _ = model.predict(np.zeros(model.observation_space.shape, np.float32),
                               deterministic=True)  # fmt: skip
