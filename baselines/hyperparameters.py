@@ -26,12 +26,12 @@ brake x Gaussian torque policy) on the manipulator's native ``action_mode="hybri
 - HybridPPO: exactly the PPO settings (no per-algorithm tuning), only the action space differs.
 - SAC with 64 copies and 4 gradient steps per 64 transitions (replay ratio 1/16, far below
   SAC's usual 1): a gradient step costs ~12-25 ms on this CPU whatever the width (overhead-
-  bound), so the usual ratio would give ~50 transitions/s; 10^6 buffer, batch 256, 2 x 256 ReLU
+  bound), so the usual ratio would give ~40 transitions/s; 10^6 buffer, batch 256, 2 x 256 ReLU
   MLPs, automatic entropy tuning, 10^4 random warm-up steps.
 - Budgets, the ones of the shipped policies (``baselines/trained``): PPO 10^7 steps on the
   manipulator, 4 x 10^6 on diff drive "time", 5 x 10^6 on "effort", HybridPPO 5 x 10^6,
   SAC 10^6 (what fitted one session on the 2-core machine: PPO runs at about 3-15 k steps/s
-  there, SAC at about 1 k). Episodes: manipulator up to 500 steps of 0.02 s, the optimum
+  there, SAC at 400-800). Episodes: manipulator up to 500 steps of 0.02 s, the optimum
   takes about 228; diff drive "time" up to 200 steps of 0.05 s, "effort" exactly 81.
   Untuned starting points: the shipped results say how far they get.
 - Seed 0 everywhere; ``train(..., seed=...)`` overrides it.

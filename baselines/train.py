@@ -42,11 +42,7 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 import mdi_envs
-from baselines.hyperparameters import (
-    ALGORITHM_CLASSES,
-    canonical_algorithm,
-    get_hyperparameters,
-)
+from baselines.hyperparameters import ALGORITHM_CLASSES, canonical_algorithm, get_hyperparameters
 
 EPISODE_COLUMNS = ("timesteps", "return", "length", "is_success", "elapsed_time", "effort")
 """Columns of ``STEM_episodes.csv`` (steps, -, steps, bool, s, N^2 m^2 s)."""

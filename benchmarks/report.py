@@ -370,12 +370,12 @@ def _to_builtin(value: Any) -> Any:
 
 
 __all__ = [
-    "json_safe",
     "ENTRY_KEYS",
     "aggregate_size_study",
     "format_residual",
     "format_ratio",
     "format_us",
+    "json_safe",
     "markdown_table",
     "peer_table",
     "plot_ratios",

@@ -72,7 +72,7 @@ def solve_problem(
     """
     base = make_problem(name, num_intervals)
     schedule = schedule or SCHEDULES.get(name)
-    model, _ = model_of(base)
+    model, parameters = model_of(base)
     start = time.perf_counter()
     factors = GUESS_TIME_FACTORS.get(name, (1.0,))
     workers = min(len(factors), os.cpu_count() or 1) if workers is None else int(workers)
@@ -91,7 +91,6 @@ def solve_problem(
     arrays, final_time = best["arrays"], best["final_time"]
     starts = [{"guess_final_time": s["guess_final_time"], "cost": s["cost"],
                "converged": s["converged"], "solve_time": s["solve_time"]} for s in solved]
-    parameters = model_of(problem)[1]
     big_n = problem.num_intervals
     metadata: dict[str, Any] = {
         "name": name,
