@@ -26,7 +26,7 @@ Each case's docstring states its criteria and why their limits hold. Shared crit
 complementarity solve did not report CONVERGED; limit 0). Where the manipulator is driven beyond
 what its dt resolves (overdrive, dt = 0.1 s, the brake toggled at full torque for 10^5 steps) the
 stepper must say so: its INACCURATE status (the under-resolution flag, see
-``mdi_envs.stepping._kernel.RESOLVED_INERTIA_FRACTION``) is then reported in the metrics, not
+``mdi_envs.stepping._free_motion.RESOLVED_INERTIA_FRACTION``) is then reported in the metrics, not
 counted as a failure, and the energy balance must hold up to the first flagged step (no silent
 energy gain). Long runs call ``step_batch`` with
 ``num_substeps`` = a stride and record every stride-th state (the status is the worst over the

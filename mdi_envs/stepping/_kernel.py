@@ -26,10 +26,17 @@ from numba import njit
 
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
-from mdi_envs.solvers._linalg import dominates, invert_into
+from mdi_envs.solvers._linalg import invert_into
 from mdi_envs.solvers.lcp.enumerative import enumerative_kernel
 from mdi_envs.solvers.lcp.lemke import lemke_kernel
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
+from mdi_envs.stepping._midpoint import (
+    MOTION_SINGULAR,
+    MOTION_UNDER_RESOLVED,
+    free_motion_shapes,
+    make_free_motion,
+    make_midpoint_rows,
+)
 
 GAP_TOLERANCE = 1e-12
 """[m] A contact counts as closed at the midpoint when g_i(q_M) <= this: a body resting on a
@@ -39,17 +46,6 @@ IDEAL_BRAKE_IMPULSE = 1e6
 """[N s or N m s] A brake whose impulse bound a dt reaches this acts as the ideal brake
 (equality row). The Tresca rows carry P_B = P_R - a dt, which loses all precision when a dt is
 many orders above P_B; no brake of these models needs impulses anywhere near this bound."""
-
-RESOLVED_INERTIA_FRACTION = 0.9
-"""A step counts as resolved while the symmetric part of M_theta = M - dt/2 J exceeds this
-fraction of M: the linearized velocity forces change the inertia by less than 10 % in every
-direction (the manipulator from rest at dt = 0.01 s: up to 30-50 rad/s on both joints in
-opposite senses, i.e. 0.6-1 rad of relative rotation per step)."""
-
-# Outcomes of the smooth part of a step (``make_free_motion``).
-MOTION_RESOLVED = 0  # M_theta = M - dt/2 J used
-MOTION_UNDER_RESOLVED = 1  # dt too coarse for the linearization: status INACCURATE
-MOTION_SINGULAR = 2  # the iteration matrix could not be inverted: status BREAKDOWN
 
 # Layout of the per-step diagnostics vector.
 INFO_STATUS = 0  # SolverStatus code of the step's solve (CONVERGED when nothing to solve)
@@ -73,11 +69,16 @@ class StepShortcuts(NamedTuple):
             step and reused (full path: M(q_M) is evaluated and inverted every step).
         direct_solve_max_size: LCPs up to this size are solved by exact enumeration instead of
             Lemke's method (0: always Lemke).
+        closed_form_single_row: a step with one impulse row (one frictionless contact or one
+            brake: the manipulator's engaged brake) takes the law's closed-form solution, a
+            projection of the unconstrained impulse onto [0, inf), [-a dt, a dt] or R (full
+            path: the MLCP of that row).
     """
 
     skip_frictionless_rows: bool = True
     reuse_constant_mass: bool = True
     direct_solve_max_size: int = 3
+    closed_form_single_row: bool = True
 
 
 Layout = dict[str, tuple[int, tuple[int, ...]]]
@@ -91,23 +92,24 @@ def _workspace_layout(model: type[ModelDefinition]) -> tuple[Layout, int, Layout
     lcp = 3 * c + 2 * k  # LCP variables: 3 per contact, 2 per Tresca brake
     size = lcp + k  # plus the ideal-brake equalities
     float_shapes: dict[str, tuple[int, ...]] = {
-        "qm": (n,), "M": (n, n), "Minv": (n, n), "h": (n,), "B": (n, m), "ufree": (n,),
-        "g": (c,), "Wc": (c * d, n), "Wb": (k, n), "eps": (c,), "mu": (c,), "Wr": (rows, n),
-        "MinvWt": (n, rows), "G": (rows, rows), "gfree": (rows,), "gpre": (rows,),
-        "S": (rows, size), "s0": (rows,), "A": (size, size), "a": (size,),
+        # the free motion and the active set (``advance``, through flat offsets)
+        **free_motion_shapes(n, m), "g": (c,), "Wc": (c * d, n), "Wb": (k, n),
+        "eps": (c,), "mu": (c,),
+        # the complementarity problem (``solve_active_set``)
+        "Wr": (rows, n), "MinvWt": (n, rows), "G": (rows, rows), "gfree": (rows,),
+        "gpre": (rows,), "S": (rows, size), "s0": (rows,), "A": (size, size), "a": (size,),
         "Mred": (lcp, lcp), "qred": (lcp,), "z": (lcp,), "T": (lcp, lcp + 2),
         "pivot_row": (lcp + 2,), "Aee": (k, k), "Aee_inv": (k, k), "lu_work": (k, k),
-        "lu_col": (k,), "v": (size,), "P": (rows,), "Mwork": (n, n), "col": (n,),
-        "row_eps": (rows,),
+        "lu_col": (k,), "v": (size,), "P": (rows,), "row_eps": (rows,),
         # the impact-locating step (``locate_impacts``): gaps at t_k, the state at the
         # impact, and one part's impulses and diagnostics
         "g0": (c,), "q_hit": (n,), "u_hit": (n,), "part_impulses": (rows,),
         "part_info": (INFO_SIZE,),
     }
     int_shapes: dict[str, tuple[int, ...]] = {
-        "basis": (lcp,), "row_of": (2 * lcp + 1,), "slot_of": (2 * lcp + 1,),
-        "slot_var": (lcp + 1,), "row_ref": (rows,), "row_var": (rows,),
-        "mass_ready": (1,),
+        "mass_ready": (1,), "basis": (lcp,), "row_of": (2 * lcp + 1,),
+        "slot_of": (2 * lcp + 1,), "slot_var": (lcp + 1,), "row_ref": (rows,),
+        "row_var": (rows,),
     }
 
     def offsets(shapes: dict[str, tuple[int, ...]]) -> tuple[Layout, int]:
@@ -149,82 +151,6 @@ def _make_carver(layout: Layout) -> Any:
     return njit(namespace["carve"])
 
 
-def make_free_motion(
-    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts
-) -> Any:
-    """Compile the smooth part of the step shared by the planar and the spatial kernels.
-
-    ``free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)`` writes
-    q_M = q + dt/2 u and u_free = u + M_theta^-1 (h(q_M, u) + B tau) dt, where the iteration
-    matrix M_theta = M(q_M) - theta dt dh/du(q_M, u) with theta = 1/2 (M_theta = M when h does
-    not depend on u), into ``M`` and its inverse into ``Minv``. All arrays are modified in place;
-    M^-1 is kept across steps when the model's mass is constant, h independent of u and the
-    shortcut on. Returns ``MOTION_RESOLVED``; ``MOTION_UNDER_RESOLVED`` when the step is too
-    coarse for the linearization (the symmetric part of M_theta does not exceed 0.9 M: dt |u|
-    is no longer small against the configuration scale, e.g. an arm turning about a radian per
-    step; the step is still taken with M_theta, and reports ``INACCURATE``: dropping J there
-    was tried and diverges to inf, while M_theta near singular can multiply the energy);
-    ``MOTION_SINGULAR`` if the matrix cannot be inverted.
-
-    The theta term makes velocity-dependent forces linearly implicit (the theta-method of
-    Siconos' MoreauJeanOSI): the step then solves M(q_M)(u+ - u) = (h + theta J (u+ - u) + B tau)
-    dt + W P, with J = dh/du, which for the quadratic Coriolis/centrifugal forces of a Lagrangian
-    model is h evaluated bilinearly in u and u+. The explicit form (theta = 0) pumps energy and
-    angular momentum into a spinning manipulator (+89 % energy over 50 s at dt = 0.01 s); this
-    form keeps the drift at O(dt^2) (4e-5). J's columns are the exact central differences
-    (h(u + e_j) - h(u - e_j)) / 2 of a function at most quadratic in u.
-    """
-    n, num_inputs = model.NUM_DOFS, model.NUM_INPUTS
-    mass, forces, inputs = eq.mass, eq.forces, eq.inputs
-    velocity_forces = model.HAS_VELOCITY_FORCES
-    reuse_mass = (shortcuts.reuse_constant_mass and model.HAS_CONSTANT_MASS
-                  and not velocity_forces)
-
-    @njit(inline="always")
-    def free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col,  # noqa: ANN001
-                    mass_ready):
-        for i in range(n):
-            qm[i] = q[i] + 0.5 * dt * u[i]
-        forces(qm, u, p, h)
-        inputs(qm, p, B)
-        motion = MOTION_RESOLVED
-        if not (reuse_mass and mass_ready[0] == 1):
-            mass(qm, p, M)
-            if velocity_forces:
-                # M -= theta dt J with theta = 1/2; M(q_M) kept in Minv until the inversion,
-                # probes in ufree, col and Mwork[0].
-                for i in range(n):
-                    for j in range(n):
-                        Minv[i, j] = M[i, j]
-                for j in range(n):
-                    for i in range(n):
-                        ufree[i] = u[i]
-                    ufree[j] = u[j] + 1.0
-                    forces(qm, ufree, p, col)
-                    ufree[j] = u[j] - 1.0
-                    forces(qm, ufree, p, Mwork[0])
-                    for i in range(n):
-                        M[i, j] -= 0.25 * dt * (col[i] - Mwork[0, i])
-                if not dominates(M, Minv, RESOLVED_INERTIA_FRACTION, Mwork):
-                    motion = MOTION_UNDER_RESOLVED
-            if not invert_into(M, Minv, Mwork, col):
-                motion = MOTION_SINGULAR
-            mass_ready[0] = 0 if motion == MOTION_SINGULAR else 1
-        for i in range(n):
-            f = h[i]
-            for j in range(num_inputs):
-                f += B[i, j] * tau[j]
-            col[i] = f * dt
-        for i in range(n):
-            acc = u[i]
-            for j in range(n):
-                acc += Minv[i, j] * col[j]
-            ufree[i] = acc
-        return motion
-
-    return free_motion
-
-
 def make_step_kernels(
     model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts,
     locate_impacts: bool = False,
@@ -246,17 +172,21 @@ def make_step_kernels(
             f"(it has {c} contacts, {k} brakes)"
         )
     gaps = eq.gaps
-    contact_rows, brake_rows = eq.contact_rows, eq.brake_rows
-    restitutions, friction_coefficients = eq.restitutions, eq.friction_coefficients
     keep_frictionless_rows = not shortcuts.skip_frictionless_rows
-    free_motion = make_free_motion(model, eq, shortcuts)
+    closed_form_single_row = shortcuts.closed_form_single_row
     direct_solve_max_size = shortcuts.direct_solve_max_size
     float_layout, _, int_layout, _ = _workspace_layout(model)
     carve_floats = _make_carver(float_layout)
     carve_ints = _make_carver(int_layout)
+    free_motion = make_free_motion(model, shortcuts.reuse_constant_mass)
+    midpoint_rows = make_midpoint_rows(
+        model, {name: shape for name, (_, shape) in float_layout.items()})
+    at_qm, at_Minv, at_ufree = (float_layout[name][0] for name in ("qm", "Minv", "ufree"))
+    at_g, at_Wc, at_Wb, at_eps, at_mu = (float_layout[name][0]
+                                         for name in ("g", "Wc", "Wb", "eps", "mu"))
 
     @njit(inline="always")
-    def advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fs, js):  # noqa: ANN001
+    def advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fws, iws):  # noqa: ANN001
         """Advance one step of length dt [s].
 
         Args:
@@ -268,13 +198,14 @@ def make_step_kernels(
             impulses: (c*d + k,) output, overwritten: per contact P_N then P_T, then the
                 brake impulses [N s or N m s]; zero for open contacts and released brakes.
             info: (INFO_SIZE,) output diagnostics (see the INFO_* constants).
-            fs, js: the float and int scratch views carved from ``make_workspace``'s buffers.
+            fws, iws: the float and int buffers of ``make_workspace``.
+
+        This inlined part takes the free motion, finds the active set and finishes the steps
+        without a problem to solve, or with one row (closed form), on fixed offsets of the flat
+        buffer; ``solve_active_set`` takes the rest on array views. (Every array view alive
+        here would cost reference counting on each step: most of a free step's time.)
         """
-        (qm, M, Minv, h, B, ufree, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree, gpre, S, s0,
-         A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P, Mwork,
-         col, row_eps, _, _, _, _, _) = fs
-        basis, row_of, slot_of, slot_var, row_ref, row_var, mass_ready = js
-        motion = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
+        motion = free_motion(q, u, tau, dt, p, fws, iws)
         ok = motion != MOTION_SINGULAR
         for i in range(c * d + k):
             impulses[i] = 0.0
@@ -286,23 +217,23 @@ def make_step_kernels(
         info[INFO_EQUALITIES] = 0.0
 
         # Active set: contacts closed at the midpoint, brakes with a positive bound.
-        gaps(qm, p, g)
-        contact_rows(qm, p, Wc)
-        brake_rows(qm, p, Wb)
-        restitutions(p, eps)
-        friction_coefficients(p, mu)
+        midpoint_rows(p, fws)
         num_rows = 0
         num_x = 0
         num_eq = 0
         num_active = 0
+        last_row = -1  # impulse index of the last active row
         for i in range(c):
-            if g[i] <= GAP_TOLERANCE:
+            if fws[at_g + i] <= GAP_TOLERANCE:
+                frictional = fws[at_mu + i] > 0.0 or keep_frictionless_rows
                 num_active += 1
-                num_rows += 2 if mu[i] > 0.0 or keep_frictionless_rows else 1
-                num_x += 3 if mu[i] > 0.0 or keep_frictionless_rows else 1
+                num_rows += 2 if frictional else 1
+                num_x += 3 if frictional else 1
+                last_row = i * d
         for j in range(k):
             if brake_bound[j] > 0.0:
                 num_rows += 1
+                last_row = c * d + j
                 if brake_bound[j] * dt >= IDEAL_BRAKE_IMPULSE:
                     num_eq += 1
                 else:
@@ -310,10 +241,57 @@ def make_step_kernels(
         info[INFO_ACTIVE_CONTACTS] = num_active
         if num_rows == 0 or not ok:
             for i in range(n):
-                u_out[i] = ufree[i]
-                q_out[i] = qm[i] + 0.5 * dt * u_out[i]
+                u_out[i] = fws[at_ufree + i]
+                q_out[i] = fws[at_qm + i] + 0.5 * dt * u_out[i]
             return
+        if num_rows == 1 and closed_form_single_row:
+            # One normal row (frictionless contact) or one brake row w: with G = w M^-1 w^T
+            # and xi = w u_free + G P + eps w u, the law's unique solution is the projection
+            # of P* = -(w u_free + eps w u) / G onto [0, inf) (Signorini-Newton), [-a dt, a dt]
+            # (Tresca) or R (ideal brake).
+            if last_row < c * d:
+                at_w = at_Wc + last_row * n
+                eps_row = fws[at_eps + last_row // d]
+                low, high = 0.0, np.inf
+            else:
+                at_w = at_Wb + (last_row - c * d) * n
+                eps_row = 0.0
+                bound = brake_bound[last_row - c * d] * dt
+                low, high = ((-np.inf, np.inf) if bound >= IDEAL_BRAKE_IMPULSE
+                             else (-bound, bound))
+            G_row = 0.0
+            xi_free = 0.0
+            for j in range(n):
+                acc = 0.0
+                for t in range(n):
+                    acc += fws[at_Minv + j * n + t] * fws[at_w + t]
+                G_row += fws[at_w + j] * acc
+                xi_free += fws[at_w + j] * (fws[at_ufree + j] + eps_row * u[j])
+            if G_row > 0.0:
+                P_row = min(max(-xi_free / G_row, low), high)
+                impulses[last_row] = P_row
+                info[INFO_LCP_SIZE] = num_x
+                info[INFO_EQUALITIES] = num_eq
+                for j in range(n):
+                    acc = 0.0
+                    for t in range(n):
+                        acc += fws[at_Minv + j * n + t] * fws[at_w + t]
+                    u_out[j] = fws[at_ufree + j] + acc * P_row
+                    q_out[j] = fws[at_qm + j] + 0.5 * dt * u_out[j]
+                return
+        solve_active_set(q, u, brake_bound, dt, motion, num_rows, num_x, num_eq, q_out, u_out,
+                         impulses, info, fws, iws)
 
+    @njit
+    def solve_active_set(q, u, brake_bound, dt, motion, num_rows, num_x, num_eq,  # noqa: ANN001
+                         q_out, u_out, impulses, info, fws, iws):
+        """The step's complementarity problem on the active set ``advance`` found, and the
+        step's end: ``num_rows`` impulse rows, ``num_x`` LCP variables, ``num_eq`` ideal
+        brakes; the other arguments as ``advance``'s."""
+        (qm, M, Minv, h, B, ufree, Mwork, col, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree,
+         gpre, S, s0, A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P,
+         row_eps, _, _, _, _, _) = carve_floats(fws)
+        _, basis, row_of, slot_of, slot_var, row_ref, row_var = carve_ints(iws)
         # Rows W (num_rows, n), their free and pre-step velocities, and eps on normal rows.
         r = 0
         for i in range(c):
@@ -430,7 +408,7 @@ def make_step_kernels(
 
     @njit
     def located_advance(q, u, tau, brake_bound, dt, p, q_out, u_out,  # noqa: ANN001
-                        impulses, info, fs, js):
+                        impulses, info, fws, iws):
         """``advance``, but a step in which an open contact closes is split at the impact.
 
         The parts: flight to t*, the impact law alone (a step of length 0), the rest.
@@ -445,9 +423,10 @@ def make_step_kernels(
         usual. Outputs as ``advance``: impulses summed over the parts, the worst status, the
         iterations summed, the other diagnostics of the part that closed the most contacts.
         """
-        Wc, ufree = fs[7], fs[5]
+        fs = carve_floats(fws)
+        ufree, Wc = fs[5], fs[9]
         g0, q_hit, u_hit, part_impulses, part_info = fs[-5], fs[-4], fs[-3], fs[-2], fs[-1]
-        advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fs, js)
+        advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fws, iws)
         gaps(q, p, g0)
         hit = dt
         for i in range(c):
@@ -468,7 +447,7 @@ def make_step_kernels(
             q_from = q if part == 0 else q_out
             u_from = u if part == 0 else u_out
             advance(q_from, u_from, tau, brake_bound, length, p, q_hit, u_hit, part_impulses,
-                    part_info, fs, js)
+                    part_info, fws, iws)
             for j in range(n):
                 q_out[j] = q_hit[j]
                 u_out[j] = u_hit[j]
@@ -491,8 +470,7 @@ def make_step_kernels(
     @njit
     def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
         """One step (arguments as ``advance``; ws = ``make_workspace(model)``)."""
-        step_once(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info,
-                  carve_floats(ws[0]), carve_ints(ws[1]))
+        step_once(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws[0], ws[1])
 
     @njit
     def step_batch(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, ws):  # noqa: ANN001
@@ -507,15 +485,14 @@ def make_step_kernels(
             ws: one workspace from ``make_workspace``, shared by the copies.
         """
         num_copies = Q.shape[0]
-        fs = carve_floats(ws[0])
-        js = carve_ints(ws[1])
+        fws, iws = ws
         q_next = np.empty(n)
         u_next = np.empty(n)
         for e in range(num_copies):
             worst = 0.0
             for _ in range(num_substeps):
                 step_once(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e],
-                          INFO[e], fs, js)
+                          INFO[e], fws, iws)
                 for j in range(n):
                     Q[e, j] = q_next[j]
                     U[e, j] = u_next[j]
@@ -631,7 +608,6 @@ __all__ = [
     "IDEAL_BRAKE_IMPULSE",
     "INFO_STATUS",
     "StepShortcuts",
-    "make_free_motion",
     "make_step_kernels",
     "make_workspace",
 ]

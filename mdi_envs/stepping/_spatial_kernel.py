@@ -55,6 +55,13 @@ from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers.fc3d.newton_ac import make_workspace as make_newton_workspace
 from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
+from mdi_envs.stepping._midpoint import (
+    MOTION_SINGULAR,
+    MOTION_UNDER_RESOLVED,
+    free_motion_shapes,
+    make_free_motion,
+    offsets_of,
+)
 from mdi_envs.stepping._kernel import (
     INFO_ACTIVE_CONTACTS,
     INFO_EQUALITIES,
@@ -62,10 +69,7 @@ from mdi_envs.stepping._kernel import (
     INFO_LCP_SIZE,
     INFO_SIZE,
     INFO_STATUS,
-    MOTION_SINGULAR,
-    MOTION_UNDER_RESOLVED,
     StepShortcuts,
-    make_free_motion,
 )
 
 # The spatial step's diagnostics extend the planar layout (same meaning of entries 0..4;
@@ -89,16 +93,23 @@ SLIP_ATOL = 1e-8
 def make_spatial_workspace(model: type[ModelDefinition]) -> tuple[Any, ...]:
     """Preallocated arrays for the spatial ``step`` of ``model``, reused across steps and copies.
 
-    The last entries are the warm start (previous impulses, (c*3,)) and its validity flag.
+    The first entry is the free motion's flat buffer (``_midpoint.free_motion_shapes``; the
+    arrays qm, M, Minv, h, B, ufree, Mwork, col are views into it); the last entries are the
+    warm start (previous impulses, (c*3,)) and its validity flag.
     """
     n, m, c = model.NUM_DOFS, model.NUM_INPUTS, model.NUM_CONTACTS
     f = np.empty
+    shapes = free_motion_shapes(n, m)
+    offsets, total = offsets_of(shapes)
+    motion_buffer = f(total)
+    view = {name: motion_buffer[offsets[name]:offsets[name] + int(np.prod(shape))].reshape(shape)
+            for name, shape in shapes.items()}
     return (
-        f(n), f((n, n)), f((n, n)), f(n), f((n, m)), f(n), f((3 * c, n)), f(c),
-        f((2 * c, n)), f((n, 2 * c)), f((2 * c, 2 * c)), f(2 * c), f(c), f((c, 2 * c)),
-        f((3 * c, 3 * c)), f(3 * c), f(3 * c), f(c), f((n, n)), f(n), np.zeros(c, np.int64),
-        make_newton_workspace(3 * c), np.zeros(1, np.int64), f(3 * c), np.zeros(3 * c),
-        np.zeros(1, np.int64),
+        motion_buffer, view["qm"], view["M"], view["Minv"], view["h"], view["B"],
+        view["ufree"], f((3 * c, n)), f(c), f((2 * c, n)), f((n, 2 * c)), f((2 * c, 2 * c)),
+        f(2 * c), f(c), f((c, 2 * c)), f((3 * c, 3 * c)), f(3 * c), f(3 * c), f(c),
+        view["Mwork"], view["col"], np.zeros(c, np.int64), make_newton_workspace(3 * c),
+        np.zeros(1, np.int64), f(3 * c), np.zeros(3 * c), np.zeros(1, np.int64),
     )
 
 
@@ -127,7 +138,7 @@ def make_spatial_step_kernels(
     contact_rows, friction_coefficients = eq.contact_rows, eq.friction_coefficients
     normal_loads = njit(model.normal_loads)
     slip_mode = njit(model.slip_mode)
-    free_motion = make_free_motion(model, eq, shortcuts)
+    free_motion = make_free_motion(model, shortcuts.reuse_constant_mass)
     c2 = 2 * c
     c3 = 3 * c
 
@@ -143,9 +154,9 @@ def make_spatial_step_kernels(
             info: (SPATIAL_INFO_SIZE,) output diagnostics (INFO_* constants).
             ws: workspace from ``make_spatial_workspace``; carries the warm start.
         """
-        (qm, M, Minv, h, B, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho, Mwork,
-         col, sliding, nws, mass_ready, r_best, warm, warm_ready) = ws
-        motion = free_motion(q, u, tau, dt, p, qm, M, Minv, h, B, ufree, Mwork, col, mass_ready)
+        (motion_buffer, qm, M, Minv, h, B, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r,
+         rho, Mwork, col, sliding, nws, mass_ready, r_best, warm, warm_ready) = ws
+        motion = free_motion(q, u, tau, dt, p, motion_buffer, mass_ready)
         ok = motion != MOTION_SINGULAR
         for i in range(c3):
             impulses[i] = 0.0

@@ -70,3 +70,31 @@ def test_released_brake_and_open_contacts_solve_nothing() -> None:
     for result in (ball, arm):
         assert (result.lcp_size, result.num_equalities, result.num_iter) == (0, 0, 0)
         assert not result.impulses.any()
+
+
+def test_single_row_closed_form_equals_the_mlcp() -> None:
+    """One active row (an engaged brake, ideal or Tresca; a frictionless contact) in closed
+    form gives the MLCP path's trajectory, impulses and problem sizes."""
+    steps = 3000
+    torques = 2.0 * np.sign(np.sin(np.linspace(0.0, 9.0, steps)))
+    brakes = np.where(np.arange(steps) % 700 < 300, np.inf, 0.0)
+    brakes[1500:2100] = np.where(brakes[1500:2100] > 0.0, 0.4, 0.0)  # Tresca phases
+    arm_closed = MoreauJeanStepper(BlockableManipulator, time_step=1e-3)
+    arm_mlcp = MoreauJeanStepper(BlockableManipulator, time_step=1e-3,
+                                 shortcuts=StepShortcuts(closed_form_single_row=False))
+    ball_pushes = 0.3 * np.sin(np.linspace(0.0, 20.0, steps))
+    params = BouncingBallParameters(restitution=0.6)
+    ball_closed = MoreauJeanStepper(BouncingBall, params, 1e-3)
+    ball_mlcp = MoreauJeanStepper(BouncingBall, params, 1e-3,
+                                  StepShortcuts(closed_form_single_row=False))
+    for closed, mlcp, q0, pushes, brake in (
+        (arm_closed, arm_mlcp, [0.0, 0.3], torques, brakes),
+        (ball_closed, ball_mlcp, [0.0, 0.5], ball_pushes, None),
+    ):
+        c_states, c_imp, c_sizes = _rollout(closed, q0, pushes, brake)
+        m_states, m_imp, m_sizes = _rollout(mlcp, q0, pushes, brake)
+        np.testing.assert_allclose(c_states, m_states, rtol=0.0, atol=1e-12)
+        np.testing.assert_allclose(c_imp, m_imp, rtol=0.0, atol=1e-12)
+        assert c_sizes == m_sizes
+        assert np.abs(c_imp).max() > 0.0  # rows were active
+    assert {0, 2} <= set(_rollout(arm_closed, [0.0, 0.3], torques, brakes)[2])  # Tresca taken
