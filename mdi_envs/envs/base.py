@@ -156,7 +156,8 @@ class MoreauJeanTask:
         self._settings = np.array([
             self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
             self.effort_weight, self.goal_weight, self.shaping_weight, self.shaping_discount,
-        ])  # read by the compiled ``advance`` (see ``_compiled``)
+            *self.stepper.compiled_step_batch[1],
+        ])  # read by the compiled ``advance`` (see ``_compiled``), the model's record last
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle without the compiled kernels (rebuilt on first use)."""
@@ -225,12 +226,12 @@ class MoreauJeanTask:
             RuntimeError: the physics produced a non-finite state.
         """
         if self._kernels is None:
-            self._kernels = _compiled(type(self), self.stepper.compiled_step_batch[0])
-        _, record, workspace = self.stepper.compiled_step_batch
+            self._kernels = _compiled(type(self), *self.stepper.compiled_step_batch[:2])
         finite = self._kernels[0](
-            state.q, state.u, state.tau, state.brake, state.impulses, state.physics, record,
-            workspace, self._settings, self._constants, state.elapsed_steps, state.effort,
+            state.q, state.u, state.tau, state.brake, state.impulses, state.physics,
+            self._settings, self._constants, state.elapsed_steps, state.effort,
             state.potential, state.terminated, state.reward, state.obs, state.info,
+            *self.stepper.compiled_step_batch[2],
         )
         if not finite:
             raise RuntimeError(
@@ -252,7 +253,7 @@ class MoreauJeanTask:
 
     def observe(self, state: BatchState) -> Any:
         """Recompute every copy's observation into ``state.obs`` and return it."""
-        observe_all = _compiled(type(self), self.stepper.compiled_step_batch[0])[1]
+        observe_all = _compiled(type(self), *self.stepper.compiled_step_batch[:2])[1]
         observe_all(state.q, state.u, state.brake, state.elapsed_steps, self.num_horizon_steps,
                     self.dt, self._constants, state.obs)
         return state.obs
@@ -271,7 +272,7 @@ class MoreauJeanTask:
 
     def update_potential(self, state: BatchState, index: int) -> None:
         """Phi of copy ``index`` after its state was set from outside the step."""
-        distance_one = _compiled(type(self), self.stepper.compiled_step_batch[0])[2]
+        distance_one = _compiled(type(self), *self.stepper.compiled_step_batch[:2])[2]
         distance = distance_one(state.q[index], state.u[index], self._constants)
         state.potential[index] = -self.shaping_weight * distance
 
@@ -508,20 +509,29 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         return self.state.obs.copy(), reward, terminated, truncated, infos
 
 
-_COMPILED: dict[tuple[type[MoreauJeanTask], Any], tuple[Any, Any, Any]] = {}
+_COMPILED: dict[tuple[type[MoreauJeanTask], Any, type], tuple[Any, Any, Any]] = {}
+SETTINGS_SIZE = 8
+"""Entries of ``MoreauJeanTask._settings`` before the model's parameter record."""
 
 
-def _compiled(task: type[MoreauJeanTask], step_batch: Any) -> tuple[Any, Any, Any]:
-    """The batched kernels of ``task`` on the stepper kernel ``step_batch`` (compiled once per
-    pair and process).
+def _compiled(task: type[MoreauJeanTask], step_batch: Any, record: Any
+              ) -> tuple[Any, Any, Any]:  # fmt: skip
+    """The batched kernels of ``task`` on the stepper kernel ``step_batch`` whose parameter
+    record is like ``record`` (compiled once per task, kernel and record type, per process).
 
     Returns (advance, observe_all, distance_one). ``advance`` runs the physics substeps and
     then the rewards, observations and info of every copy in one compiled call (one dispatch
-    from Python per env step).
+    from Python per env step). Its arguments are flat arrays only, the stepper's workspace
+    last, unpacked: the record is rebuilt inside from the settings array, since each tuple
+    argument costs microseconds of typing per call.
     """
-    key = (task, step_batch)
+    key = (task, step_batch, type(record))
     if key in _COMPILED:
         return _COMPILED[key]
+    fields = ", ".join(f"settings[{SETTINGS_SIZE + i}]" for i in range(len(record)))
+    namespace: dict[str, Any] = {"Record": type(record)}
+    exec(f"def read_record(settings):\n    return Record({fields})", namespace)  # noqa: S102
+    read_record = njit(inline="always")(namespace["read_record"])
     observe_one = njit(task.observe_one)
     distance_one = njit(task.distance_one)
     success_one = njit(task.success_one)
@@ -573,10 +583,10 @@ def _compiled(task: type[MoreauJeanTask], step_batch: Any) -> tuple[Any, Any, An
         return finite
 
     @njit
-    def advance(q, u, tau, brake, impulses, physics, record, workspace, settings,  # noqa: ANN001
-                c, elapsed, effort, potential, terminated, reward, obs, info):
-        step_batch(q, u, tau, brake, settings[0], record, int(settings[1]), impulses, physics,
-                   workspace)
+    def advance(q, u, tau, brake, impulses, physics, settings, c, elapsed,  # noqa: ANN001
+                effort, potential, terminated, reward, obs, info, *workspace):
+        step_batch(q, u, tau, brake, settings[0], read_record(settings), int(settings[1]),
+                   impulses, physics, workspace)
         return evaluate(q, u, tau, brake, impulses, physics, c, settings[2], int(settings[3]),
                         settings[4], settings[5], settings[6], settings[7], elapsed, effort,
                         potential, terminated, reward, obs, info)
