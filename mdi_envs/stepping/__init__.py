@@ -10,10 +10,12 @@ from mdi_envs.stepping.event_driven import (
     simulate_ball,
     simulate_manipulator,
 )
+from mdi_envs.stepping.in_place import InPlaceStepper
 from mdi_envs.stepping.moreau_jean import MoreauJeanStepper, StepResult
 
 __all__ = [
     "EventDrivenIntegrator",
+    "InPlaceStepper",
     "MoreauJeanStepper",
     "PiecewiseConstant",
     "StepResult",

@@ -172,6 +172,19 @@ class MoreauJeanStepper:
         return self._step_batch, self._values, self._workspace
 
     @property
+    def compiled_step(self) -> Any:
+        """The single-step kernel ``step(q, u, tau, brake, dt, record, q_out, u_out, impulses,
+        info, workspace)`` behind ``step`` (no input checks)."""
+        return self._step
+
+    def in_place(self, q: Any, u: Any) -> Any:
+        """An ``InPlaceStepper`` at (q, u): one copy stepped in place by one compiled call
+        per step, the fastest single steps from Python (see ``mdi_envs.stepping.in_place``)."""
+        from mdi_envs.stepping.in_place import InPlaceStepper
+
+        return InPlaceStepper(self, q, u)
+
+    @property
     def info_size(self) -> int:
         """Columns of the per-copy diagnostics ``step_batch`` returns."""
         return self._info_size
