@@ -11,8 +11,8 @@ results tables (the ones in ``benchmarks/README.md``) on stdout. Parts:
 
 1. compile: the first ``step`` and ``step_batch`` call of every stepper (numba JIT), timed once
    and excluded from everything else;
-2. single step: ``MoreauJeanStepper.step`` from Python per scene, the compiled kernel called
-   from Python with preallocated arrays (the dispatch cost alone), the in-kernel cost per step
+2. single step: ``MoreauJeanStepper.step`` from Python per scene, ``InPlaceStepper.step`` (one
+   compiled call on a flat buffer: the fastest single step from Python), the in-kernel cost per step
    (``step_batch`` on N copies of the one scene), and MuJoCo's ``mj_step`` / ``rollout``;
 3. batched: µs per copy-step of ``step_batch`` on each model's scene mix for N = 1 ... 4096,
    each call lasting at least ``call_s``, interleaved with MuJoCo's single-thread ``rollout``;
@@ -201,25 +201,33 @@ def compile_steppers(cases: list[ModelCase], log: Progress, notes: list[str]
     return kept, steppers, records
 
 
-def _raw_kernel_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
-    """The stepper's compiled kernel, called from Python with preallocated arrays.
-
-    Uses the stepper's private kernel and workspace: the public ``step`` minus its argument
-    checks and output allocation, i.e. the numba dispatch plus the step itself.
-    """
+def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
+    """``InPlaceStepper.step`` at the scene: the public fastest single step from Python (one
+    compiled call on a flat buffer). The state advances in place, so every 200th call first
+    puts it back at the scene's (included in the timing: about 2 ns per call)."""
     q, u, tau, brake = arrays
-    brake = np.zeros(st.num_brakes) if brake is None else brake
-    outputs = (np.empty(st.num_dofs), np.empty(st.num_dofs), np.empty(st.num_impulses),
-               np.empty(st._info_size))
-    args = (q, u, tau, brake, float(st.time_step), st._values, *outputs, st._workspace)
-    kernel = st._step
-    return lambda: kernel(*args)
+    stepper = st.in_place(q, u)
+    stepper.tau[:] = tau
+    if brake is not None:
+        stepper.brake_bound[:] = brake
+    calls = [0]
+    step = stepper.step
+
+    def call() -> None:
+        calls[0] += 1
+        if calls[0] == 200:
+            calls[0] = 0
+            stepper.q[:] = q
+            stepper.u[:] = u
+        step()
+
+    return call
 
 
 def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
                       arm: MujocoArm | None, config: EngineConfig, log: Progress
                       ) -> list[dict[str, Any]]:
-    """Per scene: ``step`` from Python, the raw kernel from Python, and MuJoCo's ``mj_step``."""
+    """Per scene: ``step`` and ``InPlaceStepper.step`` from Python, and MuJoCo's ``mj_step``."""
     calls: dict[str, Callable[[], Any]] = {}
     for case in cases:
         st = steppers[case.label]
@@ -227,7 +235,7 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
             arrays = scene.arrays()
             calls[f"{case.label}|{scene.name}|step"] = (
                 lambda st=st, a=arrays: st.step(*a))
-            calls[f"{case.label}|{scene.name}|kernel"] = _raw_kernel_call(st, arrays)
+            calls[f"{case.label}|{scene.name}|in_place"] = _in_place_call(st, arrays)
     if arm is not None:
         for scene, call in arm.single_step_calls().items():
             calls[f"mujoco|{scene}|mj_step"] = call
@@ -459,7 +467,8 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
     """The brief's targets against the measurements (None where the model was not run)."""
 
     def python_worst(model: str) -> float | None:
-        values = [r["median_s"] for r in single if r["model"] == model and r["entry"] == "step"]
+        values = [r["median_s"] for r in single
+                  if r["model"] == model and r["entry"] == "in_place"]
         return max(values) if values else None
 
     def batched_at_largest(model: str) -> tuple[float | None, int | None, float | None]:
@@ -476,14 +485,14 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
                                 TARGETS_US["manipulator_batched"], value,
                                 f"N = {copies}; best over N {R.format_us_fine(best)} µs"
                                 if best is not None else ""))
-    targets.append(R.target_row("manipulator, one step() from Python (slowest scene)",
+    targets.append(R.target_row("manipulator, one InPlaceStepper.step() from Python (slowest scene)",
                                 TARGETS_US["manipulator_python"], python_worst("manipulator")))
     value, copies, best = batched_at_largest("diff_drive")
     targets.append(R.target_row("diff-drive, batched, µs per copy-step (mix, largest N)",
                                 TARGETS_US["diff_drive"], value,
                                 f"N = {copies}; best over N {R.format_us_fine(best)} µs"
                                 if best is not None else ""))
-    targets.append(R.target_row("diff-drive, one step() from Python (slowest scene)",
+    targets.append(R.target_row("diff-drive, one InPlaceStepper.step() from Python (slowest scene)",
                                 TARGETS_US["diff_drive"], python_worst("diff_drive")))
     return targets
 

@@ -105,7 +105,7 @@ def scenes_table(models: Sequence[dict[str, Any]]) -> str:
 
 def single_step_table(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str, Any]]
                       ) -> str:
-    """Markdown: per (model, scene) the Python step, the raw kernel call and the in-kernel cost."""
+    """Markdown: per (model, scene) the Python step, the in-place step and the in-kernel cost."""
     index = {(r["model"], r["scene"], r["entry"]): r["median_s"] for r in single}
     kernel = {(r["model"], r["scene"]): r["per_copy_step_s"] for r in scenes}
     copies = scenes[0]["copies"] if scenes else "N"
@@ -117,12 +117,12 @@ def single_step_table(single: Sequence[dict[str, Any]], scenes: Sequence[dict[st
             raw = None
         else:
             python = index.get((model, scene, "step"))
-            raw = index.get((model, scene, "kernel"))
+            raw = index.get((model, scene, "in_place"))
         title = "MuJoCo arm" if model == "mujoco" else MODEL_TITLES.get(model, model)
         rows.append([title, scene, format_us_fine(python), format_us_fine(raw),
                      format_us_fine(kernel.get((model, scene)))])
     header = ["model", "scene", "one step from Python µs (step() / MuJoCo mj_step)",
-              "compiled kernel from Python µs", f"in-kernel µs per step (batched, N = {copies})"]
+              "InPlaceStepper.step() from Python µs", f"in-kernel µs per step (batched, N = {copies})"]
     return markdown_table(header, rows)
 
 
@@ -294,14 +294,14 @@ def _batched_panel(ax: Any, rows_in: Sequence[dict[str, Any]], x_key: str, xlabe
 
 def plot_single_step(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str, Any]],
                      targets_us: Mapping[str, float], path: Path) -> None:
-    """Horizontal bars per (model, scene): Python step, raw kernel call, in-kernel step."""
+    """Horizontal bars per (model, scene): Python step, in-place step, in-kernel step."""
     index = {(r["model"], r["scene"], r["entry"]): r["median_s"] for r in single}
     kernel = {(r["model"], r["scene"]): r["per_copy_step_s"] for r in scenes}
     keys = list(dict.fromkeys((r["model"], r["scene"]) for r in single))
     series = [
         ("one step from Python: step() / mj_step", lambda m, s: index.get(
             (m, s, "mj_step" if m == "mujoco" else "step"))),
-        ("compiled kernel from Python", lambda m, s: index.get((m, s, "kernel"))),
+        ("InPlaceStepper.step() from Python", lambda m, s: index.get((m, s, "in_place"))),
         ("in-kernel (batched)", lambda m, s: kernel.get((m, s))),
     ]
     y = np.arange(len(keys))
