@@ -114,15 +114,16 @@ def single_step_table(single: Sequence[dict[str, Any]], scenes: Sequence[dict[st
     for model, scene in keys:
         if model == "mujoco":
             python = index.get((model, scene, "mj_step"))
-            raw = None
+            in_place = None
         else:
             python = index.get((model, scene, "step"))
-            raw = index.get((model, scene, "in_place"))
+            in_place = index.get((model, scene, "in_place"))
         title = "MuJoCo arm" if model == "mujoco" else MODEL_TITLES.get(model, model)
-        rows.append([title, scene, format_us_fine(python), format_us_fine(raw),
+        rows.append([title, scene, format_us_fine(python), format_us_fine(in_place),
                      format_us_fine(kernel.get((model, scene)))])
     header = ["model", "scene", "one step from Python µs (step() / MuJoCo mj_step)",
-              "InPlaceStepper.step() from Python µs", f"in-kernel µs per step (batched, N = {copies})"]
+              "InPlaceStepper.step() from Python µs",
+              f"in-kernel µs per step (batched, N = {copies})"]
     return markdown_table(header, rows)
 
 

@@ -36,6 +36,7 @@ from mdi_envs.stepping._midpoint import (
     free_motion_shapes,
     make_free_motion,
     make_midpoint_rows,
+    offsets_of,
 )
 
 GAP_TOLERANCE = 1e-12
@@ -112,16 +113,12 @@ def _workspace_layout(model: type[ModelDefinition]) -> tuple[Layout, int, Layout
         "row_var": (rows,),
     }
 
-    def offsets(shapes: dict[str, tuple[int, ...]]) -> tuple[Layout, int]:
-        layout: Layout = {}
-        total = 0
-        for name, shape in shapes.items():
-            layout[name] = (total, shape)
-            total += int(np.prod(shape))
-        return layout, total
+    def layout_of(shapes: dict[str, tuple[int, ...]]) -> tuple[Layout, int]:
+        offsets, total = offsets_of(shapes)
+        return {name: (offsets[name], shape) for name, shape in shapes.items()}, total
 
-    float_layout, float_total = offsets(float_shapes)
-    int_layout, int_total = offsets(int_shapes)
+    float_layout, float_total = layout_of(float_shapes)
+    int_layout, int_total = layout_of(int_shapes)
     return float_layout, float_total, int_layout, int_total
 
 
@@ -129,8 +126,9 @@ def make_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, np.ndarray
     """Scratch buffers of ``step`` for ``model`` (one float64, one int64), reused across steps.
 
     Two flat buffers keep the compiled call cheap to dispatch from Python (numba types every
-    element of a tuple argument on each call); the step carves its arrays out of them once per
-    call, also for a whole batch.
+    element of a tuple argument on each call); the step reads and writes its free-motion and
+    active-set data at fixed offsets and carves array views only to solve a complementarity
+    problem (``solve_active_set``) or to locate an impact.
     """
     _, float_total, _, int_total = _workspace_layout(model)
     return np.empty(max(float_total, 1)), np.zeros(max(int_total, 1), np.int64)
@@ -181,7 +179,8 @@ def make_step_kernels(
     free_motion = make_free_motion(model, shortcuts.reuse_constant_mass)
     midpoint_rows = make_midpoint_rows(
         model, {name: shape for name, (_, shape) in float_layout.items()})
-    at_qm, at_Minv, at_ufree = (float_layout[name][0] for name in ("qm", "Minv", "ufree"))
+    at_qm, at_Minv, at_ufree, at_col = (float_layout[name][0]
+                                        for name in ("qm", "Minv", "ufree", "col"))
     at_g, at_Wc, at_Wb, at_eps, at_mu = (float_layout[name][0]
                                          for name in ("g", "Wc", "Wb", "eps", "mu"))
 
@@ -261,10 +260,11 @@ def make_step_kernels(
                              else (-bound, bound))
             G_row = 0.0
             xi_free = 0.0
-            for j in range(n):
+            for j in range(n):  # M^-1 w into the free motion's scratch ``col``
                 acc = 0.0
                 for t in range(n):
                     acc += fws[at_Minv + j * n + t] * fws[at_w + t]
+                fws[at_col + j] = acc
                 G_row += fws[at_w + j] * acc
                 xi_free += fws[at_w + j] * (fws[at_ufree + j] + eps_row * u[j])
             if G_row > 0.0:
@@ -273,10 +273,7 @@ def make_step_kernels(
                 info[INFO_LCP_SIZE] = num_x
                 info[INFO_EQUALITIES] = num_eq
                 for j in range(n):
-                    acc = 0.0
-                    for t in range(n):
-                        acc += fws[at_Minv + j * n + t] * fws[at_w + t]
-                    u_out[j] = fws[at_ufree + j] + acc * P_row
+                    u_out[j] = fws[at_ufree + j] + fws[at_col + j] * P_row
                     q_out[j] = fws[at_qm + j] + 0.5 * dt * u_out[j]
                 return
         solve_active_set(q, u, brake_bound, dt, motion, num_rows, num_x, num_eq, q_out, u_out,
@@ -285,9 +282,11 @@ def make_step_kernels(
     @njit
     def solve_active_set(q, u, brake_bound, dt, motion, num_rows, num_x, num_eq,  # noqa: ANN001
                          q_out, u_out, impulses, info, fws, iws):
-        """The step's complementarity problem on the active set ``advance`` found, and the
-        step's end: ``num_rows`` impulse rows, ``num_x`` LCP variables, ``num_eq`` ideal
-        brakes; the other arguments as ``advance``'s."""
+        """The step's complementarity problem on the active set ``advance`` found, and its end.
+
+        ``num_rows`` impulse rows, ``num_x`` LCP variables, ``num_eq`` ideal brakes; the other
+        arguments as ``advance``'s.
+        """
         (qm, M, Minv, h, B, ufree, Mwork, col, g, Wc, Wb, eps, mu, Wr, MinvWt, G, gfree,
          gpre, S, s0, A, a, Mred, qred, z, T, pivot_row, Aee, Aee_inv, lu_work, lu_col, v, P,
          row_eps, _, _, _, _, _) = carve_floats(fws)
@@ -423,9 +422,7 @@ def make_step_kernels(
         usual. Outputs as ``advance``: impulses summed over the parts, the worst status, the
         iterations summed, the other diagnostics of the part that closed the most contacts.
         """
-        fs = carve_floats(fws)
-        ufree, Wc = fs[5], fs[9]
-        g0, q_hit, u_hit, part_impulses, part_info = fs[-5], fs[-4], fs[-3], fs[-2], fs[-1]
+        g0, q_hit, u_hit, part_impulses, part_info = carve_floats(fws)[-5:]
         advance(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, fws, iws)
         gaps(q, p, g0)
         hit = dt
@@ -435,8 +432,8 @@ def make_step_kernels(
             gamma0 = 0.0
             gamma_free = 0.0
             for j in range(n):
-                gamma0 += Wc[i * d, j] * u[j]
-                gamma_free += Wc[i * d, j] * ufree[j]
+                gamma0 += fws[at_Wc + i * d * n + j] * u[j]
+                gamma_free += fws[at_Wc + i * d * n + j] * fws[at_ufree + j]
             if g0[i] + 0.5 * dt * (gamma0 + gamma_free) > 0.0:
                 continue  # still open at t_k + dt
             hit = min(hit, _first_root(g0[i], gamma0, 0.5 * (gamma_free - gamma0) / dt, dt))

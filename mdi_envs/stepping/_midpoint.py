@@ -8,8 +8,8 @@ central differences of dh/du) and keeps the small matrix algebra in registers. R
 fixed offsets of one flat scratch buffer, written once, never through array views: each view
 costs reference counting on every step, which was most of a free step's time. The source is
 generated per model (sizes and flags are compile-time constants), like
-``_kernel._make_carver``; on this machine the manipulator's free motion takes about 50 ns
-instead of 250 ns through array-filling kernels.
+``_kernel._make_carver``. The manipulator's free step in-kernel: ``python -m benchmarks.engine
+--output /tmp/bench --quick``, scene "released" (about 0.1 us; 0.4 us before this module).
 """
 
 from __future__ import annotations

@@ -55,13 +55,6 @@ from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers.fc3d.newton_ac import make_workspace as make_newton_workspace
 from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
-from mdi_envs.stepping._midpoint import (
-    MOTION_SINGULAR,
-    MOTION_UNDER_RESOLVED,
-    free_motion_shapes,
-    make_free_motion,
-    offsets_of,
-)
 from mdi_envs.stepping._kernel import (
     INFO_ACTIVE_CONTACTS,
     INFO_EQUALITIES,
@@ -70,6 +63,13 @@ from mdi_envs.stepping._kernel import (
     INFO_SIZE,
     INFO_STATUS,
     StepShortcuts,
+)
+from mdi_envs.stepping._midpoint import (
+    MOTION_SINGULAR,
+    MOTION_UNDER_RESOLVED,
+    free_motion_shapes,
+    make_free_motion,
+    offsets_of,
 )
 
 # The spatial step's diagnostics extend the planar layout (same meaning of entries 0..4;

@@ -16,20 +16,32 @@ from numba import njit
 
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers.status import SolverStatus
+from mdi_envs.stepping._kernel import INFO_STATUS
+from mdi_envs.stepping.moreau_jean import (
+    _INPUT_PROBLEMS,
+    _STATUS_OF_CODE,
+    MoreauJeanStepper,
+    _screen_inputs,
+)
 
 _KERNELS: dict[tuple[Any, type], Any] = {}
 
 
-def _make_kernel(step: Any, record: Any, n: int, m: int, k: int, num_impulses: int,
-                 info_size: int, screen: Any) -> Any:
-    """Compile ``step_in_place(buffer, *workspace)`` for ``step`` (a stepper's single step)."""
-    names = ("q", "u", "tau", "brake", "q_next", "u_next", "impulses", "info")
-    sizes = (n, n, m, k, n, n, num_impulses, info_size)
+def _buffer_layout(stepper: MoreauJeanStepper) -> list[tuple[str, int]]:
+    """(name, size) of the buffer's parts after the parameter record and dt, in order."""
+    n, m, k = stepper.num_dofs, stepper.num_inputs, stepper.num_brakes
+    return [("q", n), ("u", n), ("tau", m), ("brake", k), ("q_next", n), ("u_next", n),
+            ("impulses", stepper.num_impulses), ("info", stepper.info_size)]
+
+
+def _make_kernel(stepper: MoreauJeanStepper) -> Any:
+    """Compile ``step_in_place(buffer, *workspace)`` around ``stepper.compiled_step``."""
+    record = stepper.compiled_step_batch[1]
     start = len(record) + 1  # the record, then dt
     lines = ["def step_in_place(buffer, *workspace):",
              "    p = Record(" + ", ".join(f"buffer[{i}]" for i in range(len(record))) + ")",
              f"    dt = buffer[{len(record)}]"]
-    for name, size in zip(names, sizes, strict=True):
+    for name, size in _buffer_layout(stepper):
         lines.append(f"    {name} = buffer[{start}:{start + size}]")
         start += size
     lines += [
@@ -37,12 +49,13 @@ def _make_kernel(step: Any, record: Any, n: int, m: int, k: int, num_impulses: i
         "    if problem != 0:",
         "        return problem",
         "    step(q, u, tau, brake, dt, p, q_next, u_next, impulses, info, workspace)",
-        f"    for i in range({n}):",
+        f"    for i in range({stepper.num_dofs}):",
         "        q[i] = q_next[i]",
         "        u[i] = u_next[i]",
         "    return 0",
     ]
-    namespace: dict[str, Any] = {"Record": type(record), "step": step, "screen": screen}
+    namespace: dict[str, Any] = {"Record": type(record), "step": stepper.compiled_step,
+                                 "screen": _screen_inputs}
     exec("\n".join(lines), namespace)  # noqa: S102 - generated from the model's sizes
     return njit(namespace["step_in_place"])
 
@@ -66,33 +79,28 @@ class InPlaceStepper:
         True
     """
 
-    def __init__(self, stepper: Any, q: Any, u: Any) -> None:
-        from mdi_envs.stepping.moreau_jean import _INPUT_PROBLEMS, _screen_inputs
-
+    def __init__(self, stepper: MoreauJeanStepper, q: Any, u: Any) -> None:
         record = stepper.compiled_step_batch[1]
-        n, m, k = stepper.num_dofs, stepper.num_inputs, stepper.num_brakes
         key = (stepper.compiled_step, type(record))
         if key not in _KERNELS:
-            _KERNELS[key] = _make_kernel(stepper.compiled_step, record, n, m, k,
-                                         stepper.num_impulses, stepper.info_size,
-                                         _screen_inputs)  # fmt: skip
+            _KERNELS[key] = _make_kernel(stepper)
         self._kernel = _KERNELS[key]
-        self._problems = _INPUT_PROBLEMS
         self._workspace = stepper.compiled_step_batch[2]
-        sizes = (n, n, m, k, n, n, stepper.num_impulses, stepper.info_size)
-        self._buffer = np.zeros(len(record) + 1 + sum(sizes))
+        layout = _buffer_layout(stepper)
+        self._buffer = np.zeros(len(record) + 1 + sum(size for _, size in layout))
         self._buffer[: len(record)] = record
         self._buffer[len(record)] = stepper.time_step
         views = []
         start = len(record) + 1
-        for size in sizes:
+        for _, size in layout:
             views.append(self._buffer[start:start + size])
             start += size
         self.q, self.u, self.tau, self.brake_bound, _, _, self.impulses, self._info = views
         for name, value in (("q", q), ("u", u)):
             array = np.asarray(value, dtype=np.float64)
-            if array.shape != (n,):
-                raise ValueError(f"{name} must have shape ({n},), got {array.shape}")
+            if array.shape != (stepper.num_dofs,):
+                raise ValueError(f"{name} must have shape ({stepper.num_dofs},), "
+                                 f"got {array.shape}")
             getattr(self, name)[:] = array
 
     def step(self) -> None:
@@ -103,12 +111,12 @@ class InPlaceStepper:
         """
         problem = self._kernel(self._buffer, *self._workspace)
         if problem:
-            raise ValueError(self._problems[problem])
+            raise ValueError(_INPUT_PROBLEMS[problem])
 
     @property
     def status(self) -> SolverStatus:
         """The last step's solve status (CONVERGED when nothing had to be solved)."""
-        return tuple(SolverStatus)[int(self._info[0])]
+        return _STATUS_OF_CODE[int(self._info[INFO_STATUS])]
 
     @property
     def diagnostics(self) -> FloatArray:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -36,6 +36,9 @@ from mdi_envs.stepping._spatial_kernel import (
     make_spatial_step_kernels,
     make_spatial_workspace,
 )
+
+if TYPE_CHECKING:
+    from mdi_envs.stepping.in_place import InPlaceStepper
 
 _KERNELS: dict[tuple[type[ModelDefinition], StepShortcuts, bool], tuple[Any, Any]] = {}
 
@@ -173,16 +176,21 @@ class MoreauJeanStepper:
 
     @property
     def compiled_step(self) -> Any:
-        """The single-step kernel ``step(q, u, tau, brake, dt, record, q_out, u_out, impulses,
-        info, workspace)`` behind ``step`` (no input checks)."""
+        """The single-step kernel behind ``step`` (no input checks).
+
+        ``step(q, u, tau, brake, dt, record, q_out, u_out, impulses, info, workspace)``.
+        """
         return self._step
 
-    def in_place(self, q: Any, u: Any) -> Any:
-        """An ``InPlaceStepper`` at (q, u): one copy stepped in place by one compiled call
-        per step, the fastest single steps from Python (see ``mdi_envs.stepping.in_place``)."""
-        from mdi_envs.stepping.in_place import InPlaceStepper
+    def in_place(self, q: Any, u: Any) -> InPlaceStepper:
+        """An ``InPlaceStepper`` at (q, u): one copy stepped in place.
 
-        return InPlaceStepper(self, q, u)
+        One compiled call per step, the fastest single steps from Python (see
+        ``mdi_envs.stepping.in_place``).
+        """
+        from mdi_envs.stepping.in_place import InPlaceStepper as in_place_stepper  # a cycle
+
+        return in_place_stepper(self, q, u)
 
     @property
     def info_size(self) -> int:
