@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from mdi_envs._types import FloatArray
@@ -67,6 +68,78 @@ def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool
     return True
 
 
+
+
+@njit(cache=True)
+def solve_consistent_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float,
+                             rel_consistency_tol: float) -> bool:
+    """Solve a possibly singular but consistent ``A x = b`` by complete pivoting, in place.
+
+    Gaussian elimination with complete pivoting stops at the first pivot below
+    ``rel_pivot_tol * max|A|`` (the numerical rank r). The system counts as consistent when the
+    eliminated right-hand side's last n - r entries are at most ``rel_consistency_tol * max|b|``;
+    then x solves the r independent equations with the n - r free unknowns at 0 (a basic
+    solution; for duplicated rows, an exact solution of all of them).
+
+    Args:
+        A: (n, n) matrix; overwritten by its factors. b: (n,) right-hand side; overwritten by
+            x on success (garbage otherwise).
+        rel_pivot_tol, rel_consistency_tol: relative tolerances as above.
+
+    Returns:
+        True if solved, False if inconsistent (or A = 0 with b != 0).
+    """
+    n = A.shape[0]
+    scale = 0.0
+    b_scale = 0.0
+    for i in range(n):
+        b_scale = max(b_scale, abs(b[i]))
+        for j in range(n):
+            scale = max(scale, abs(A[i, j]))
+    column_of = np.arange(n)
+    rank = n
+    threshold = rel_pivot_tol * scale
+    for k in range(n):
+        p = k
+        c = k
+        best = -1.0
+        for i in range(k, n):
+            for j in range(k, n):
+                a = abs(A[i, j])
+                if a > best:
+                    best = a
+                    p = i
+                    c = j
+        if not best > threshold:
+            rank = k
+            break
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+            b[k], b[p] = b[p], b[k]
+        if c != k:
+            for i in range(n):
+                A[i, k], A[i, c] = A[i, c], A[i, k]
+            column_of[k], column_of[c] = column_of[c], column_of[k]
+        inv = 1.0 / A[k, k]
+        for i in range(k + 1, n):
+            f = A[i, k] * inv
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+                b[i] -= f * b[k]
+    for i in range(rank, n):
+        if abs(b[i]) > rel_consistency_tol * b_scale:
+            return False
+    x = np.zeros(n)
+    for i in range(rank - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, rank):
+            s -= A[i, j] * x[j]
+        x[i] = s / A[i, i]
+    for j in range(n):
+        b[column_of[j]] = x[j]
+    return True
 
 
 @njit(cache=True)
@@ -138,4 +211,4 @@ def dominates(A: FloatArray, M: FloatArray, fraction: float, work: FloatArray) -
     return True
 
 
-__all__ = ["dominates", "invert_into", "lu_solve_inplace"]
+__all__ = ["dominates", "invert_into", "lu_solve_inplace", "solve_consistent_inplace"]

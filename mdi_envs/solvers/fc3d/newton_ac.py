@@ -15,7 +15,10 @@ so an element of the generalized Jacobian is ``J = blockdiag(A) + blockrows(B) W
 (``alart_curnier_local`` computes phi_i, A_i and B_i of one contact; both this method and the
 Gauss-Seidel method call it). Each step solves ``J d = -phi`` by LU with partial pivoting and
 backtracks on the merit function ``psi = |phi|^2 / 2`` (Armijo). When J is singular to working
-precision or the Newton direction is not a descent direction, the step is a
+precision, the system is solved by complete pivoting if it is consistent (duplicated rows, as
+two contacts on one line in the same state give: the redundant increments are set to 0, which
+keeps the step exact on the current piece). When it is inconsistent or the Newton direction is
+not a descent direction, the step is a
 Levenberg-Marquardt step ``(J^T J + lambda I) d = -J^T phi`` with lambda proportional to |phi|,
 and failing that the steepest-descent direction ``-J^T phi``.
 
@@ -44,7 +47,7 @@ import numpy as np
 from numba import njit
 
 from mdi_envs._types import FloatArray
-from mdi_envs.solvers._linalg import lu_solve_inplace
+from mdi_envs.solvers._linalg import lu_solve_inplace, solve_consistent_inplace
 from mdi_envs.solvers._registry import (
     SolverOptions,
     require_integer_option,
@@ -60,6 +63,9 @@ from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_MAX_ITE
 
 _PIVOT_TOL = 1e-14
 """Relative pivot tolerance below which the Newton matrix counts as singular."""
+_CONSISTENCY_TOL = 1e-10
+"""A singular Newton system counts as consistent when its eliminated residual is below this
+fraction of |phi| (then the step solves it with the redundant unknowns' increments at 0)."""
 _SLOW_STEP = 1.0 / 32.0
 """A step length below this counts as a poor step: regularise (more)."""
 _PROX_ETA = 0.5
@@ -235,26 +241,47 @@ def alart_curnier(
     return psi
 
 
+_NUM_VECTORS = 10
+"""Length-n scratch vectors of ``newton_ac_core`` (then the A, B blocks and two n x n)."""
+
+
+@njit(cache=True)
+def workspace_size(n: int) -> int:
+    """Length of the flat float64 buffer ``workspace_in`` carves for a problem of size n = 3 nc."""
+    return _NUM_VECTORS * n + 2 * 9 * (n // 3) + 2 * n * n
+
+
+@njit(cache=True)
+def workspace_in(buffer: FloatArray, n: int) -> Workspace:
+    """Scratch arrays of ``newton_ac_core`` as views into ``buffer`` (>= ``workspace_size(n)``).
+
+    Lets a caller keep the solver's scratch inside its own flat buffer.
+    """
+    nc = n // 3
+    blocks = _NUM_VECTORS * n
+    matrices = blocks + 18 * nc
+    return (
+        buffer[0:n],  # u = W r + q
+        buffer[n:2 * n],  # velocity of the proximal sub-problem
+        buffer[2 * n:3 * n],  # proximal centre
+        buffer[3 * n:4 * n],  # phi
+        buffer[blocks:blocks + 9 * nc].reshape((nc, 3, 3)),  # A
+        buffer[blocks + 9 * nc:matrices].reshape((nc, 3, 3)),  # B
+        buffer[matrices:matrices + n * n].reshape((n, n)),  # J
+        buffer[matrices + n * n:matrices + 2 * n * n].reshape((n, n)),  # factored J (or LM)
+        buffer[4 * n:5 * n],  # d
+        buffer[5 * n:6 * n],  # grad = J^T phi
+        buffer[6 * n:7 * n],  # (W + sigma D) d
+        buffer[7 * n:8 * n],  # trial r
+        buffer[8 * n:9 * n],  # trial u
+        buffer[9 * n:10 * n],  # trial phi
+    )
+
+
 @njit(cache=True)
 def make_workspace(n: int) -> Workspace:
     """Scratch arrays of ``newton_ac_core`` for a problem of size n = 3 nc."""
-    nc = n // 3
-    return (
-        np.empty(n),  # u = W r + q
-        np.empty(n),  # velocity of the proximal sub-problem
-        np.empty(n),  # proximal centre
-        np.empty(n),  # phi
-        np.empty((nc, 3, 3)),  # A
-        np.empty((nc, 3, 3)),  # B
-        np.empty((n, n)),  # J
-        np.empty((n, n)),  # factored copy of J (or of J^T J + lambda I)
-        np.empty(n),  # d
-        np.empty(n),  # grad = J^T phi
-        np.empty(n),  # (W + sigma D) d
-        np.empty(n),  # trial r
-        np.empty(n),  # trial u
-        np.empty(n),  # trial phi
-    )
+    return workspace_in(np.empty(workspace_size(n)), n)
 
 
 @njit(cache=True)
@@ -334,7 +361,14 @@ def _search_direction(
         for j in range(n):
             H[i, j] = J[i, j]
         d[i] = -phi[i]
-    if lu_solve_inplace(H, d, _PIVOT_TOL):
+    solved = lu_solve_inplace(H, d, _PIVOT_TOL)
+    if not solved:  # singular: duplicated rows (redundant contacts) still give a Newton step
+        for i in range(n):
+            for j in range(n):
+                H[i, j] = J[i, j]
+            d[i] = -phi[i]
+        solved = solve_consistent_inplace(H, d, _PIVOT_TOL, _CONSISTENCY_TOL)
+    if solved:
         slope = 0.0
         d_norm2 = 0.0
         for i in range(n):
@@ -499,4 +533,6 @@ __all__ = [
     "newton_ac_core",
     "newton_ac_kernel",
     "solve_newton_ac",
+    "workspace_in",
+    "workspace_size",
 ]
