@@ -265,6 +265,7 @@ class MoreauJeanTask:
         state.u[index] = u
         state.tau[index] = 0.0
         state.brake[index] = 0.0
+        state.impulses[index] = 0.0  # the first step starts its solver cold
         state.elapsed_steps[index] = 0
         state.effort[index] = 0.0
         state.terminated[index] = False
@@ -290,7 +291,8 @@ class BatchState:
         steps. effort: (N,) integral of sum(tau^2) [N^2 m^2 s]. potential: (N,) Phi of the
         current state. terminated: (N,) whether the last step ended the episode. reward (N,),
         obs (N, NUM_OBSERVATIONS) float32, info (N, len(info_keys)): the last step's outputs.
-        impulses, physics: the stepper's outputs of the last physics step.
+        impulses, physics: the stepper's outputs of the last physics step (the impulses also
+        warm-start the next step's solver for spatial contacts; zero after a reset).
     """
 
     def __init__(self, task: MoreauJeanTask, num_copies: int) -> None:
@@ -358,6 +360,7 @@ class MoreauJeanEnv(gym.Env[Any, Any]):
             _require(bool(np.isfinite(array).all()), f"{name} contains NaN or inf entries")
         self.state.q[0] = q
         self.state.u[0] = u
+        self.state.impulses[0] = 0.0  # no warm start from another state
         self.task.update_potential(self.state, 0)
         self.task.observe(self.state)
 

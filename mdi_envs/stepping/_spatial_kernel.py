@@ -26,16 +26,18 @@ friction impulses. The complementarity is invariant under the positive scale s, 
 makes both kinds of rows commensurate. The problem is solved in units of the weight impulse
 P0 = sum(N0) dt and the velocity s P0 (r / P0, u / (s P0)), to an absolute tolerance
 ``NEWTON_TOL`` in these units, by the compiled semismooth Newton method on the Alart-Curnier
-function (``newton_ac_core``), warm-started from the previous step's impulses. If that does not
-converge it restarts from the static loads without friction, then from zero, and otherwise
-keeps the iterate with the smallest residual (``INFO_ITERATIONS`` counts all Newton steps).
+function (``newton_ac_core``), warm-started from the impulses passed in (the previous
+step's). If that does not converge it restarts from the static loads without friction, then
+from zero, and otherwise keeps the iterate with the smallest residual (``INFO_ITERATIONS``
+counts all Newton steps).
 Where the load transfer is strong enough to lift contacts (a tall, narrow robot that would tip
 over) the problem can have several solutions and Newton may still fail: the status says so.
 
 The wheels' lateral rows are identical (both lie on the axle), so G_TT is singular while both
 wheels roll: the split of the lateral impulse between them is not determined by the rigid model
 (any split inside the cones is a solution; the motion and the normal impulses, which depend on
-its sum only, are). The Newton method's proximal safeguard handles this.
+its sum only, are). The Newton method solves its then singular but consistent systems by
+complete pivoting; the warm start selects the split.
 
 Mode (the paper's Table 1) from the slip after the step: contact i slides when
 ``|W_T,i u+| > SLIP_RTOL * v_ref + SLIP_ATOL * s P0``, with v_ref the largest single term
@@ -52,8 +54,8 @@ from numba import njit
 
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
-from mdi_envs.solvers.fc3d.newton_ac import make_workspace as make_newton_workspace
-from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
+from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core, workspace_in
+from mdi_envs.solvers.fc3d.newton_ac import workspace_size as newton_workspace_size
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
 from mdi_envs.stepping._kernel import (
     INFO_ACTIVE_CONTACTS,
@@ -90,27 +92,26 @@ SLIP_ATOL = 1e-8
 """... plus this fraction of the solver's velocity unit s P0 (its accuracy is ~1e-12 of it)."""
 
 
-def make_spatial_workspace(model: type[ModelDefinition]) -> tuple[Any, ...]:
-    """Preallocated arrays for the spatial ``step`` of ``model``, reused across steps and copies.
-
-    The first entry is the free motion's flat buffer (``_midpoint.free_motion_shapes``; the
-    arrays qm, M, Minv, h, B, ufree, Mwork, col are views into it); the last entries are the
-    warm start (previous impulses, (c*3,)) and its validity flag.
-    """
+def _spatial_shapes(model: type[ModelDefinition]) -> dict[str, tuple[int, ...]]:
+    """The spatial step's float scratch arrays in buffer order (the free motion's first)."""
     n, m, c = model.NUM_DOFS, model.NUM_INPUTS, model.NUM_CONTACTS
-    f = np.empty
-    shapes = free_motion_shapes(n, m)
-    offsets, total = offsets_of(shapes)
-    motion_buffer = f(total)
-    view = {name: motion_buffer[offsets[name]:offsets[name] + int(np.prod(shape))].reshape(shape)
-            for name, shape in shapes.items()}
-    return (
-        motion_buffer, view["qm"], view["M"], view["Minv"], view["h"], view["B"],
-        view["ufree"], f((3 * c, n)), f(c), f((2 * c, n)), f((n, 2 * c)), f((2 * c, 2 * c)),
-        f(2 * c), f(c), f((c, 2 * c)), f((3 * c, 3 * c)), f(3 * c), f(3 * c), f(c),
-        view["Mwork"], view["col"], np.zeros(c, np.int64), make_newton_workspace(3 * c),
-        np.zeros(1, np.int64), f(3 * c), np.zeros(3 * c), np.zeros(1, np.int64),
-    )
+    return {
+        **free_motion_shapes(n, m), "Wc": (3 * c, n), "mu": (c,), "WT": (2 * c, n),
+        "MinvWt": (n, 2 * c), "G": (2 * c, 2 * c), "bT": (2 * c,), "n0": (c,),
+        "K": (c, 2 * c), "Wf": (3 * c, 3 * c), "qf": (3 * c,), "r": (3 * c,), "rho": (c,),
+        "r_best": (3 * c,), "newton": (newton_workspace_size(3 * c),),
+    }
+
+
+def make_spatial_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, np.ndarray]:
+    """Scratch buffers of the spatial ``step`` of ``model`` (one float64, one int64).
+
+    Flat buffers keep the compiled call cheap to dispatch from Python; the step carves its
+    arrays (``_spatial_shapes``, the free motion's first, then the Newton solver's scratch)
+    from them. The int buffer holds the constant-mass flag, then the per-contact slip flags.
+    """
+    _, total = offsets_of(_spatial_shapes(model))
+    return np.empty(total), np.zeros(1 + model.NUM_CONTACTS, np.int64)
 
 
 def make_spatial_step_kernels(
@@ -141,6 +142,11 @@ def make_spatial_step_kernels(
     free_motion = make_free_motion(model, shortcuts.reuse_constant_mass)
     c2 = 2 * c
     c3 = 3 * c
+    at, _ = offsets_of(_spatial_shapes(model))
+    qm_at, minv_at, ufree_at, wc_at, mu_at = at["qm"], at["Minv"], at["ufree"], at["Wc"], at["mu"]
+    wt_at, minvwt_at, g_at, bt_at, n0_at = at["WT"], at["MinvWt"], at["G"], at["bT"], at["n0"]
+    k_at, wf_at, qf_at, r_at, rho_at = at["K"], at["Wf"], at["qf"], at["r"], at["rho"]
+    best_at, newton_at = at["r_best"], at["newton"]
 
     @njit
     def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
@@ -150,13 +156,42 @@ def make_spatial_step_kernels(
             q, u: (n,) coordinates and velocities at t_k. tau: (m,) inputs, held over the step.
             brake_bound: (0,) unused (no brakes). dt: step [s]. p: parameter record.
             q_out, u_out: (n,) outputs at t_k + dt (overwritten).
-            impulses: (c*3,) output: per contact (P_N, P_T1, P_T2) [N s].
+            impulses: (c*3,) per contact (P_N, P_T1, P_T2) [N s]. In: the warm start (the
+                previous step's impulses; no positive normal impulse or a non-finite entry
+                means a cold start). Out: this step's impulses.
             info: (SPATIAL_INFO_SIZE,) output diagnostics (INFO_* constants).
-            ws: workspace from ``make_spatial_workspace``; carries the warm start.
+            ws: (float, int) buffers from ``make_spatial_workspace``.
         """
-        (motion_buffer, qm, M, Minv, h, B, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r,
-         rho, Mwork, col, sliding, nws, mass_ready, r_best, warm, warm_ready) = ws
-        motion = free_motion(q, u, tau, dt, p, motion_buffer, mass_ready)
+        fws, iws = ws
+        qm = fws[qm_at:qm_at + n]
+        Minv = fws[minv_at:minv_at + n * n].reshape((n, n))
+        ufree = fws[ufree_at:ufree_at + n]
+        Wc = fws[wc_at:wc_at + c3 * n].reshape((c3, n))
+        mu = fws[mu_at:mu_at + c]
+        WT = fws[wt_at:wt_at + c2 * n].reshape((c2, n))
+        MinvWt = fws[minvwt_at:minvwt_at + n * c2].reshape((n, c2))
+        G = fws[g_at:g_at + c2 * c2].reshape((c2, c2))
+        bT = fws[bt_at:bt_at + c2]
+        n0 = fws[n0_at:n0_at + c]
+        K = fws[k_at:k_at + c * c2].reshape((c, c2))
+        Wf = fws[wf_at:wf_at + c3 * c3].reshape((c3, c3))
+        qf = fws[qf_at:qf_at + c3]
+        r = fws[r_at:r_at + c3]
+        rho = fws[rho_at:rho_at + c]
+        r_best = fws[best_at:best_at + c3]
+        nws = workspace_in(fws[newton_at:], c3)
+        mass_ready = iws[0:1]
+        sliding = iws[1:1 + c]
+
+        # The warm start, read before the impulses are overwritten.
+        warm_load = 0.0
+        for i in range(c3):
+            r[i] = impulses[i]
+            if not np.isfinite(impulses[i]):
+                warm_load = -np.inf
+        for i in range(c):
+            warm_load += impulses[3 * i]
+        motion = free_motion(q, u, tau, dt, p, fws, mass_ready)
         ok = motion != MOTION_SINGULAR
         for i in range(c3):
             impulses[i] = 0.0
@@ -249,7 +284,7 @@ def make_spatial_step_kernels(
         tol = max(NEWTON_TOL / max(np.sqrt(q_norm), 1.0), NEWTON_TOL_FLOOR)
         # Starts, until one converges: the previous impulses (warm), the static loads without
         # friction, zero. Keep the best result (by residual) if none does.
-        attempt = 0 if warm_ready[0] == 1 else 1
+        attempt = 0 if warm_load > 0.0 else 1
         code = CODE_BREAKDOWN
         iterations = 0
         residual = np.inf
@@ -257,7 +292,7 @@ def make_spatial_step_kernels(
         while attempt <= 2:
             if attempt == 0:
                 for i in range(c3):
-                    r[i] = warm[i] / p0
+                    r[i] /= p0
             else:
                 _static_start(n0, dt / p0 if attempt == 1 else 0.0, r)
             code, steps, residual = newton_ac_core(
@@ -287,11 +322,8 @@ def make_spatial_step_kernels(
         if finite:
             for i in range(c3):
                 impulses[i] = p0 * r[i]
-                warm[i] = impulses[i]
-            warm_ready[0] = 1
-        else:  # keep the state finite; the status says the solve failed
+        else:  # keep the state finite (and the next step cold); the status says it failed
             info[INFO_STATUS] = CODE_BREAKDOWN
-            warm_ready[0] = 0
 
         # u+ = u_free + M^-1 W_T^T P_T, q+ = q_M + dt/2 u+.
         for j in range(n):
@@ -330,19 +362,17 @@ def make_spatial_step_kernels(
         Args:
             Q, U: (N, n) states, overwritten. TAU: (N, m) inputs. BRAKE: (N, 0) unused.
             dt: step [s]. p: parameter record. num_substeps: steps per call.
-            IMPULSES: (N, c*3) output: the impulses of each copy's last step.
+            IMPULSES: (N, c*3) the impulses of each copy's last step. Read first as each
+                copy's warm start (zeros: a cold start), as in ``step``.
             INFO: (N, SPATIAL_INFO_SIZE) output: diagnostics of each copy's last step, except
                 the status, which is the worst (largest code) over the substeps.
-            ws: one workspace from ``make_spatial_workspace``, shared by the copies; each copy
-                starts cold and warm-starts its later substeps from its previous one.
+            ws: one workspace from ``make_spatial_workspace``, shared by the copies.
         """
         num_copies = Q.shape[0]
         q_next = np.empty(n)
         u_next = np.empty(n)
-        warm_ready = ws[-1]
         for e in range(num_copies):
             worst = 0.0
-            warm_ready[0] = 0
             for _ in range(num_substeps):
                 step(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e], INFO[e], ws)
                 for j in range(n):

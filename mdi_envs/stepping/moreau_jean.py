@@ -159,8 +159,7 @@ class MoreauJeanStepper:
     def __reduce__(self) -> tuple[Any, ...]:
         """Pickle as the constructor's arguments.
 
-        Compiled kernels and scratch arrays are rebuilt on loading; the spatial step's warm
-        start is not carried over.
+        Compiled kernels and scratch arrays are rebuilt on loading.
         """
         return (type(self), (self.model, self.parameters, self.time_step, self.shortcuts,
                              self.locate_impacts))  # fmt: skip
@@ -198,7 +197,7 @@ class MoreauJeanStepper:
         return self._info_size
 
     def step(
-        self, q: Any, u: Any, tau: Any, brake_bound: Any = None
+        self, q: Any, u: Any, tau: Any, brake_bound: Any = None, warm_start: Any = None
     ) -> StepResult:
         """Advance one state by one step.
 
@@ -206,6 +205,10 @@ class MoreauJeanStepper:
             q: (n,) coordinates. u: (n,) velocities. tau: (m,) inputs.
             brake_bound: (k,) brake bounds a >= 0 (0 released, ``np.inf`` ideal; default all
                 released).
+            warm_start: (c*d + k,) impulses the spatial contact solver starts from, usually
+                the previous step's ``impulses`` (default: a cold start). Planar models solve
+                exactly and ignore it. Where the rigid model leaves impulses undetermined
+                (the robot's two wheels share the lateral load), it also selects the split.
 
         Raises:
             ValueError: wrong shapes, NaN/inf in q, u, tau, or a negative/NaN brake bound.
@@ -219,7 +222,9 @@ class MoreauJeanStepper:
         if problem:
             raise ValueError(_INPUT_PROBLEMS[problem])
         q_out, u_out = np.empty(self.num_dofs), np.empty(self.num_dofs)
-        impulses, info = np.empty(self.num_impulses), np.empty(self._info_size)
+        impulses = (np.zeros(self.num_impulses) if warm_start is None
+                    else self._vector(warm_start, "warm_start", self.num_impulses).copy())
+        info = np.empty(self._info_size)
         self._step(q_arr, u_arr, tau_arr, brake, float(self.time_step), self._values,
                    q_out, u_out, impulses, info, self._workspace)
         mode, lifted = 0, 0
@@ -252,7 +257,9 @@ class MoreauJeanStepper:
                 then tau and brake_bound must be C-contiguous float64 arrays, and nothing is
                 checked.
             out: preallocated (impulses, info) arrays to write into, shapes as returned
-                (only with ``check_inputs=False``; default: new arrays).
+                (only with ``check_inputs=False``; default: new arrays). Spatial models read
+                the impulses first as each copy's warm start (the previous call's impulses;
+                zeros: a cold start, as every call without ``out``).
 
         Returns:
             (impulses (N, c*d + k), info (N, INFO_SIZE)) of each copy's last step; the status
@@ -265,7 +272,7 @@ class MoreauJeanStepper:
         """
         if not check_inputs:
             if out is None:
-                out = (np.empty((q.shape[0], self.num_impulses)),
+                out = (np.zeros((q.shape[0], self.num_impulses)),
                        np.empty((q.shape[0], self._info_size)))  # fmt: skip
             impulses, info = out
             self._step_batch(q, u, tau, brake_bound, float(self.time_step), self._values,
@@ -292,7 +299,7 @@ class MoreauJeanStepper:
         brake = self._brake(brake_bound, (num_copies, self.num_brakes))
         if int(num_substeps) != num_substeps or num_substeps < 1:
             raise ValueError(f"num_substeps must be a positive integer, got {num_substeps!r}")
-        impulses = np.empty((num_copies, self.num_impulses))
+        impulses = np.zeros((num_copies, self.num_impulses))  # a cold start
         info = np.empty((num_copies, self._info_size))
         self._step_batch(q, u, tau_arr, brake, float(self.time_step), self._values,
                          int(num_substeps), impulses, info, self._workspace)

@@ -56,8 +56,10 @@ def _rollout(stepper: MoreauJeanStepper, tau: Any, steps: int,
     q = np.zeros(5) if q0 is None else np.array(q0, dtype=float)
     u = np.zeros(5) if u0 is None else np.array(u0, dtype=float)
     qs, us, imps, slips, modes, statuses, iters, lifted = [q], [u], [], [], [], set(), [], []
+    warm_start = None
     for k in range(steps):
-        res = stepper.step(q, u, tau(k) if callable(tau) else tau)
+        res = stepper.step(q, u, tau(k) if callable(tau) else tau, warm_start=warm_start)
+        warm_start = res.impulses
         rows = np.array(DiffDriveRobot.contact_directions(q + 0.5 * DT * u, p, math))
         slips.append((rows @ res.u).reshape(3, 3)[:, 1:])
         q, u = res.q, res.u
