@@ -7,7 +7,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mdi_envs.solvers._linalg import lu_solve_inplace
+from mdi_envs.solvers._linalg import lu_solve_inplace, solve_consistent_inplace
 
 
 @settings(max_examples=40, deadline=None, derandomize=True, database=None,
@@ -112,3 +112,32 @@ def test_inputs_are_overwritten() -> None:
     assert lu_solve_inplace(A_work, b, 1e-14)
     np.testing.assert_allclose(b, [1.0, 2.0], rtol=1e-14)
     assert not np.array_equal(A_work, A)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_consistent_singular_systems_are_solved_exactly(seed: int) -> None:
+    """Duplicated rows (rank n - 2): partial pivoting gives up, complete pivoting solves A x = b."""
+    rng = np.random.default_rng(seed)
+    n = 9
+    A = rng.standard_normal((n, n))
+    A[4] = A[1]
+    A[7] = -2.0 * A[2]
+    x_true = rng.standard_normal(n)
+    b = A @ x_true
+    assert not lu_solve_inplace(A.copy(), b.copy(), 1e-14)
+    A_work, x = A.copy(), b.copy()
+    assert solve_consistent_inplace(A_work, x, 1e-14, 1e-10)
+    np.testing.assert_allclose(A @ x, b, rtol=0, atol=1e-12 * np.abs(b).max())
+    # regular systems: the unique solution
+    M = rng.standard_normal((n, n))
+    y = M @ x_true
+    assert solve_consistent_inplace(M.copy(), y, 1e-14, 1e-10)
+    np.testing.assert_allclose(y, x_true, rtol=1e-9, atol=1e-9)
+
+
+def test_inconsistent_singular_systems_are_refused() -> None:
+    A = np.array([[1.0, 2.0], [1.0, 2.0]])
+    assert not solve_consistent_inplace(A.copy(), np.array([1.0, 1.5]), 1e-14, 1e-10)
+    assert solve_consistent_inplace(A.copy(), np.array([1.0, 1.0]), 1e-14, 1e-10)
+    assert solve_consistent_inplace(np.zeros((2, 2)), np.zeros(2), 1e-14, 1e-10)
+    assert not solve_consistent_inplace(np.zeros((2, 2)), np.array([0.0, 1.0]), 1e-14, 1e-10)
