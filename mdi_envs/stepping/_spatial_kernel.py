@@ -149,39 +149,26 @@ def make_spatial_step_kernels(
     best_at, newton_at = at["r_best"], at["newton"]
 
     @njit
-    def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
-        """Advance one step of length dt [s].
-
-        Args:
-            q, u: (n,) coordinates and velocities at t_k. tau: (m,) inputs, held over the step.
-            brake_bound: (0,) unused (no brakes). dt: step [s]. p: parameter record.
-            q_out, u_out: (n,) outputs at t_k + dt (overwritten).
-            impulses: (c*3,) per contact (P_N, P_T1, P_T2) [N s]. In: the warm start (the
-                previous step's impulses; no positive normal impulse or a non-finite entry
-                means a cold start). Out: this step's impulses.
-            info: (SPATIAL_INFO_SIZE,) output diagnostics (INFO_* constants).
-            ws: (float, int) buffers from ``make_spatial_workspace``.
-        """
+    def views_of(ws):  # noqa: ANN001, ANN202
+        """The step's arrays carved from the (float, int) workspace buffers, once per call."""
         fws, iws = ws
-        qm = fws[qm_at:qm_at + n]
-        Minv = fws[minv_at:minv_at + n * n].reshape((n, n))
-        ufree = fws[ufree_at:ufree_at + n]
-        Wc = fws[wc_at:wc_at + c3 * n].reshape((c3, n))
-        mu = fws[mu_at:mu_at + c]
-        WT = fws[wt_at:wt_at + c2 * n].reshape((c2, n))
-        MinvWt = fws[minvwt_at:minvwt_at + n * c2].reshape((n, c2))
-        G = fws[g_at:g_at + c2 * c2].reshape((c2, c2))
-        bT = fws[bt_at:bt_at + c2]
-        n0 = fws[n0_at:n0_at + c]
-        K = fws[k_at:k_at + c * c2].reshape((c, c2))
-        Wf = fws[wf_at:wf_at + c3 * c3].reshape((c3, c3))
-        qf = fws[qf_at:qf_at + c3]
-        r = fws[r_at:r_at + c3]
-        rho = fws[rho_at:rho_at + c]
-        r_best = fws[best_at:best_at + c3]
-        nws = workspace_in(fws[newton_at:], c3)
-        mass_ready = iws[0:1]
-        sliding = iws[1:1 + c]
+        return (
+            fws, iws[0:1], fws[qm_at:qm_at + n], fws[minv_at:minv_at + n * n].reshape((n, n)),
+            fws[ufree_at:ufree_at + n], fws[wc_at:wc_at + c3 * n].reshape((c3, n)),
+            fws[mu_at:mu_at + c], fws[wt_at:wt_at + c2 * n].reshape((c2, n)),
+            fws[minvwt_at:minvwt_at + n * c2].reshape((n, c2)),
+            fws[g_at:g_at + c2 * c2].reshape((c2, c2)), fws[bt_at:bt_at + c2],
+            fws[n0_at:n0_at + c], fws[k_at:k_at + c * c2].reshape((c, c2)),
+            fws[wf_at:wf_at + c3 * c3].reshape((c3, c3)), fws[qf_at:qf_at + c3],
+            fws[r_at:r_at + c3], fws[rho_at:rho_at + c], fws[best_at:best_at + c3],
+            workspace_in(fws[newton_at:], c3), iws[1:1 + c],
+        )
+
+    @njit
+    def advance(q, u, tau, dt, p, q_out, u_out, impulses, info, views):  # noqa: ANN001
+        """One step on the carved workspace ``views`` (other arguments as ``step``)."""
+        (fws, mass_ready, qm, Minv, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho,
+         r_best, nws, sliding) = views
 
         # The warm start, read before the impulses are overwritten.
         warm_load = 0.0
@@ -356,6 +343,22 @@ def make_spatial_step_kernels(
         info[INFO_MODE] = slip_mode(sliding)
 
     @njit
+    def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
+        """Advance one step of length dt [s].
+
+        Args:
+            q, u: (n,) coordinates and velocities at t_k. tau: (m,) inputs, held over the step.
+            brake_bound: (0,) unused (no brakes). dt: step [s]. p: parameter record.
+            q_out, u_out: (n,) outputs at t_k + dt (overwritten).
+            impulses: (c*3,) per contact (P_N, P_T1, P_T2) [N s]. In: the warm start (the
+                previous step's impulses; no positive normal impulse or a non-finite entry
+                means a cold start). Out: this step's impulses.
+            info: (SPATIAL_INFO_SIZE,) output diagnostics (INFO_* constants).
+            ws: (float, int) buffers from ``make_spatial_workspace``.
+        """
+        advance(q, u, tau, dt, p, q_out, u_out, impulses, info, views_of(ws))
+
+    @njit
     def step_batch(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, ws):  # noqa: ANN001
         """Advance N independent copies by ``num_substeps`` steps each, in place.
 
@@ -371,10 +374,11 @@ def make_spatial_step_kernels(
         num_copies = Q.shape[0]
         q_next = np.empty(n)
         u_next = np.empty(n)
+        views = views_of(ws)
         for e in range(num_copies):
             worst = 0.0
             for _ in range(num_substeps):
-                step(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e], INFO[e], ws)
+                advance(Q[e], U[e], TAU[e], dt, p, q_next, u_next, IMPULSES[e], INFO[e], views)
                 for j in range(n):
                     Q[e, j] = q_next[j]
                     U[e, j] = u_next[j]

@@ -133,6 +133,82 @@ def contact_weights(W: FloatArray, rho_scale: float) -> FloatArray:
     return rho
 
 
+@njit(cache=True, inline="always")
+def _alart_curnier_at(
+    rho: float,
+    mu: float,
+    r: FloatArray,
+    u: FloatArray,
+    phi: FloatArray,
+    A: FloatArray,
+    B: FloatArray,
+    k: int,
+    i: int,
+    with_jacobian: bool,
+) -> None:
+    """``alart_curnier_local`` of contact i at entries k..k+2 of r, u, phi (blocks A[i], B[i]).
+
+    Indexes in place of slicing: array views in a hot loop cost reference counting.
+    """
+    a_n = r[k] - rho * u[k]
+    a_t1 = r[k + 1] - rho * u[k + 1]
+    a_t2 = r[k + 2] - rho * u[k + 2]
+    if with_jacobian:
+        for a in range(3):
+            for b in range(3):
+                A[i, a, b] = 0.0
+                B[i, a, b] = 0.0
+    if a_n > 0.0:  # normal impulse active: phi_N = rho u_N
+        phi[k] = rho * u[k]
+        radius = mu * a_n
+        if with_jacobian:
+            B[i, 0, 0] = rho
+    else:  # separation: phi_N = r_N
+        phi[k] = r[k]
+        radius = 0.0
+        if with_jacobian:
+            A[i, 0, 0] = 1.0
+    norm_t = np.sqrt(a_t1 * a_t1 + a_t2 * a_t2)
+    if radius > 0.0 and norm_t <= radius:  # stick: phi_T = rho u_T
+        phi[k + 1] = rho * u[k + 1]
+        phi[k + 2] = rho * u[k + 2]
+        if with_jacobian:
+            B[i, 1, 1] = rho
+            B[i, 2, 2] = rho
+        return
+    # slide (or no normal impulse): phi_T = r_T - R n, n = a_T / |a_T|
+    if norm_t > 0.0:
+        n1 = a_t1 / norm_t
+        n2 = a_t2 / norm_t
+        s = radius / norm_t
+    else:
+        n1 = 0.0
+        n2 = 0.0
+        s = 0.0
+    phi[k + 1] = r[k + 1] - radius * n1
+    phi[k + 2] = r[k + 2] - radius * n2
+    if not with_jacobian:
+        return
+    # d(R n) = n mu H(a_N) da_N + s (I - n n^T) da_T, with da = dr - rho du
+    h1 = mu * n1 if a_n > 0.0 else 0.0
+    h2 = mu * n2 if a_n > 0.0 else 0.0
+    p11 = s * (1.0 - n1 * n1)
+    p12 = -s * n1 * n2
+    p22 = s * (1.0 - n2 * n2)
+    A[i, 1, 0] = -h1
+    A[i, 2, 0] = -h2
+    A[i, 1, 1] = 1.0 - p11
+    A[i, 1, 2] = -p12
+    A[i, 2, 1] = -p12
+    A[i, 2, 2] = 1.0 - p22
+    B[i, 1, 0] = rho * h1
+    B[i, 2, 0] = rho * h2
+    B[i, 1, 1] = rho * p11
+    B[i, 1, 2] = rho * p12
+    B[i, 2, 1] = rho * p12
+    B[i, 2, 2] = rho * p22
+
+
 @njit(cache=True)
 def alart_curnier_local(
     rho: float,
@@ -154,63 +230,8 @@ def alart_curnier_local(
             when ``with_jacobian``).
         with_jacobian: whether to fill A and B.
     """
-    a_n = r[0] - rho * u[0]
-    a_t1 = r[1] - rho * u[1]
-    a_t2 = r[2] - rho * u[2]
-    if with_jacobian:
-        for a in range(3):
-            for b in range(3):
-                A[a, b] = 0.0
-                B[a, b] = 0.0
-    if a_n > 0.0:  # normal impulse active: phi_N = rho u_N
-        phi[0] = rho * u[0]
-        radius = mu * a_n
-        if with_jacobian:
-            B[0, 0] = rho
-    else:  # separation: phi_N = r_N
-        phi[0] = r[0]
-        radius = 0.0
-        if with_jacobian:
-            A[0, 0] = 1.0
-    norm_t = np.sqrt(a_t1 * a_t1 + a_t2 * a_t2)
-    if radius > 0.0 and norm_t <= radius:  # stick: phi_T = rho u_T
-        phi[1] = rho * u[1]
-        phi[2] = rho * u[2]
-        if with_jacobian:
-            B[1, 1] = rho
-            B[2, 2] = rho
-        return
-    # slide (or no normal impulse): phi_T = r_T - R n, n = a_T / |a_T|
-    if norm_t > 0.0:
-        n1 = a_t1 / norm_t
-        n2 = a_t2 / norm_t
-        s = radius / norm_t
-    else:
-        n1 = 0.0
-        n2 = 0.0
-        s = 0.0
-    phi[1] = r[1] - radius * n1
-    phi[2] = r[2] - radius * n2
-    if not with_jacobian:
-        return
-    # d(R n) = n mu H(a_N) da_N + s (I - n n^T) da_T, with da = dr - rho du
-    h1 = mu * n1 if a_n > 0.0 else 0.0
-    h2 = mu * n2 if a_n > 0.0 else 0.0
-    p11 = s * (1.0 - n1 * n1)
-    p12 = -s * n1 * n2
-    p22 = s * (1.0 - n2 * n2)
-    A[1, 0] = -h1
-    A[2, 0] = -h2
-    A[1, 1] = 1.0 - p11
-    A[1, 2] = -p12
-    A[2, 1] = -p12
-    A[2, 2] = 1.0 - p22
-    B[1, 0] = rho * h1
-    B[2, 0] = rho * h2
-    B[1, 1] = rho * p11
-    B[1, 2] = rho * p12
-    B[2, 1] = rho * p12
-    B[2, 2] = rho * p22
+    _alart_curnier_at(rho, mu, r, u, phi, A.reshape((1, 3, 3)), B.reshape((1, 3, 3)), 0, 0,
+                      with_jacobian)
 
 
 @njit(cache=True)
@@ -233,11 +254,8 @@ def alart_curnier(
     psi = 0.0
     for i in range(mu.shape[0]):
         k = 3 * i
-        phi_i = phi[k : k + 3]
-        alart_curnier_local(
-            rho[i], mu[i], r[k : k + 3], u[k : k + 3], phi_i, A[i], B[i], with_jacobian
-        )
-        psi += 0.5 * (phi_i[0] * phi_i[0] + phi_i[1] * phi_i[1] + phi_i[2] * phi_i[2])
+        _alart_curnier_at(rho[i], mu[i], r, u, phi, A, B, k, i, with_jacobian)
+        psi += 0.5 * (phi[k] * phi[k] + phi[k + 1] * phi[k + 1] + phi[k + 2] * phi[k + 2])
     return psi
 
 
