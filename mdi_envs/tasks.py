@@ -84,8 +84,13 @@ DIFF_DRIVE_TASK = DiffDriveTask()
 
 @njit(cache=True)
 def wrap_angle(angle: float) -> float:
-    """``angle`` [rad] mapped to [-pi, pi) (compiled: also callable from the env kernels)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+    """``angle`` [rad] mapped to [-pi, pi] (compiled: also callable from the env kernels).
+
+    By floor rather than ``%`` (a libm fmod call, several times slower in the env kernels);
+    rounding can land on +-pi itself.
+    """
+    turns = math.floor((angle + math.pi) / (2.0 * math.pi))
+    return angle - 2.0 * math.pi * turns
 
 
 __all__ = [

@@ -546,16 +546,17 @@ def _compiled(task: type[MoreauJeanTask], step_batch: Any, record: Any
                  reward, obs, info):
         finite = True
         for i in range(q.shape[0]):
+            qi, ui, bi, row = q[i], u[i], brake[i], info[i]
             for j in range(q.shape[1]):
-                if not (np.isfinite(q[i, j]) and np.isfinite(u[i, j])):
+                if not (np.isfinite(qi[j]) and np.isfinite(ui[j])):
                     finite = False
             elapsed[i] += 1
             rate = 0.0
             for j in range(tau.shape[1]):
                 rate += tau[i, j] * tau[i, j]
             effort[i] += rate * dt
-            d = distance_one(q[i], u[i], c)
-            s = success_one(q[i], u[i], c)
+            d = distance_one(qi, ui, c)
+            s = success_one(qi, ui, c)
             if horizon == 0:  # objective "time": success ends the episode
                 objective = -dt
                 ended = s
@@ -569,7 +570,7 @@ def _compiled(task: type[MoreauJeanTask], step_batch: Any, record: Any
             potential[i] = phi
             reward[i] = objective + shaping + goal
             terminated[i] = ended
-            row = info[i]  # BASE_INFO_KEYS, then the scene's INFO_KEYS
+            # info: BASE_INFO_KEYS, then the scene's INFO_KEYS
             row[0] = objective
             row[1] = shaping
             row[2] = goal
@@ -580,9 +581,9 @@ def _compiled(task: type[MoreauJeanTask], step_batch: Any, record: Any
             row[7] = physics[i, INFO_STATUS]
             row[8] = physics[i, INFO_ITERATIONS]
             row[9] = physics[i, INFO_ACTIVE_CONTACTS]
-            info_one(q[i], u[i], brake[i], impulses[i], physics[i], c, row[10:])
+            info_one(qi, ui, bi, impulses[i], physics[i], c, row[10:])
             time_left = (horizon - elapsed[i]) * dt if horizon > 0 else 0.0
-            observe_one(q[i], u[i], brake[i], time_left, c, obs[i])
+            observe_one(qi, ui, bi, time_left, c, obs[i])
         return finite
 
     @njit
