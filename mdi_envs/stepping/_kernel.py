@@ -487,15 +487,15 @@ def make_step_kernels(
         u_next = np.empty(n)
         for e in range(num_copies):
             worst = 0.0
+            q, u, tau, brake, impulses, info = Q[e], U[e], TAU[e], BRAKE[e], IMPULSES[e], INFO[e]
             for _ in range(num_substeps):
-                step_once(Q[e], U[e], TAU[e], BRAKE[e], dt, p, q_next, u_next, IMPULSES[e],
-                          INFO[e], fws, iws)
+                step_once(q, u, tau, brake, dt, p, q_next, u_next, impulses, info, fws, iws)
                 for j in range(n):
-                    Q[e, j] = q_next[j]
-                    U[e, j] = u_next[j]
-                if INFO[e, INFO_STATUS] > worst:
-                    worst = INFO[e, INFO_STATUS]
-            INFO[e, INFO_STATUS] = worst
+                    q[j] = q_next[j]
+                    u[j] = u_next[j]
+                if info[INFO_STATUS] > worst:
+                    worst = info[INFO_STATUS]
+            info[INFO_STATUS] = worst
 
     return step, step_batch
 

@@ -377,14 +377,15 @@ def make_spatial_step_kernels(
         views = views_of(ws)
         for e in range(num_copies):
             worst = 0.0
+            q, u, tau, impulses, info = Q[e], U[e], TAU[e], IMPULSES[e], INFO[e]
             for _ in range(num_substeps):
-                advance(Q[e], U[e], TAU[e], dt, p, q_next, u_next, IMPULSES[e], INFO[e], views)
+                advance(q, u, tau, dt, p, q_next, u_next, impulses, info, views)
                 for j in range(n):
-                    Q[e, j] = q_next[j]
-                    U[e, j] = u_next[j]
-                if INFO[e, INFO_STATUS] > worst:
-                    worst = INFO[e, INFO_STATUS]
-            INFO[e, INFO_STATUS] = worst
+                    q[j] = q_next[j]
+                    u[j] = u_next[j]
+                if info[INFO_STATUS] > worst:
+                    worst = info[INFO_STATUS]
+            info[INFO_STATUS] = worst
 
     return step, step_batch
 
