@@ -114,8 +114,7 @@ class EngineConfig:
         shortcut_plan: timing plan per on/off pair of the shortcut study.
         scene_copies: N of the per-scene in-kernel timings, the shortcut and substeps studies.
         shortcut_cases: which shortcut measurements to run.
-        scene_min_substeps: least substeps per call in the per-scene and shortcut studies (the
-            diff-drive stepper's first substep of every call is a cold start).
+        scene_min_substeps: least substeps per call in the per-scene and shortcut studies.
         substep_grid: substeps per call of the substeps study (empty: skip it).
         substep_plan: timing plan of the substeps study.
     """
@@ -357,8 +356,7 @@ def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
                    config: EngineConfig, log: Progress) -> list[dict[str, Any]]:
     """µs per copy-step of each model's mix at N = ``scene_copies`` for a few substeps per call.
 
-    Shows what a call costs beyond its steps, and the diff-drive stepper's warm start, which
-    each copy rebuilds at the start of every ``step_batch`` call (its first substep is cold).
+    Shows what a call costs beyond its steps.
     """
     if not config.substep_grid:
         return []
