@@ -252,6 +252,31 @@ def test_coasting_dissipates_energy_and_comes_to_rest(
     assert set(run.modes[:5]) == {5} and run.modes[-1] == 2  # slides, then rests
 
 
+def test_step_batch_continues_from_the_impulses_it_is_given(
+        make: Callable[..., MoreauJeanStepper]) -> None:
+    """Two calls of 40 substeps passing the impulses on (``out``) equal one call of 80.
+
+    Bitwise; a cold restart reaches the same motion to the solver's tolerance.
+    """
+    torques = np.array([[1.0, 1.0], [0.2, 0.8], [10.0, 0.5]])
+    stepper = make()
+    q_one, u_one = np.zeros((3, 5)), np.zeros((3, 5))
+    impulses_one, _ = stepper.step_batch(q_one, u_one, torques, num_substeps=80)
+    q, u = np.zeros((3, 5)), np.zeros((3, 5))
+    out = (np.zeros((3, 9)), np.empty((3, SPATIAL_INFO_SIZE)))
+    for _ in range(2):
+        stepper.step_batch(q, u, torques, np.zeros((3, 0)), 40, check_inputs=False, out=out)
+    np.testing.assert_array_equal(q, q_one)
+    np.testing.assert_array_equal(u, u_one)
+    np.testing.assert_array_equal(out[0], impulses_one)
+    assert (out[1][:, INFO_STATUS] == SolverStatus.CONVERGED).all()
+    q_cold, u_cold = np.zeros((3, 5)), np.zeros((3, 5))
+    stepper.step_batch(q_cold, u_cold, torques, num_substeps=40)
+    stepper.step_batch(q_cold, u_cold, torques, num_substeps=40)  # restarts cold
+    np.testing.assert_allclose(u_cold, u_one, rtol=0.0, atol=1e-9)
+    np.testing.assert_allclose(q_cold, q_one, rtol=0.0, atol=1e-11)
+
+
 def test_batch_equals_single(make: Callable[..., MoreauJeanStepper]) -> None:
     torques = np.array([[1.0, 1.0], [-1.0, 1.0], [10.0, 0.5], [0.2, 2.0]])
     q = np.zeros((4, 5))
