@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from mdi_envs._types import FloatArray
@@ -71,8 +70,8 @@ def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool
 
 
 @njit(cache=True)
-def solve_consistent_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float,
-                             rel_consistency_tol: float) -> bool:
+def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
+                             rel_pivot_tol: float, rel_consistency_tol: float) -> bool:
     """Solve a possibly singular but consistent ``A x = b`` by complete pivoting, in place.
 
     Gaussian elimination with complete pivoting stops at the first pivot below
@@ -84,6 +83,8 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float,
     Args:
         A: (n, n) matrix; overwritten by its factors. b: (n,) right-hand side; overwritten by
             x on success (garbage otherwise).
+        swaps: (n,) scratch: the column swapped into place at each elimination step (indices
+            held as floats, so that callers can lend a float work vector; nothing allocated).
         rel_pivot_tol, rel_consistency_tol: relative tolerances as above.
 
     Returns:
@@ -96,7 +97,6 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float,
         b_scale = max(b_scale, abs(b[i]))
         for j in range(n):
             scale = max(scale, abs(A[i, j]))
-    column_of = np.arange(n)
     rank = n
     threshold = rel_pivot_tol * scale
     for k in range(n):
@@ -117,10 +117,10 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float,
             for j in range(n):
                 A[k, j], A[p, j] = A[p, j], A[k, j]
             b[k], b[p] = b[p], b[k]
+        swaps[k] = c
         if c != k:
             for i in range(n):
                 A[i, k], A[i, c] = A[i, c], A[i, k]
-            column_of[k], column_of[c] = column_of[c], column_of[k]
         inv = 1.0 / A[k, k]
         for i in range(k + 1, n):
             f = A[i, k] * inv
@@ -131,14 +131,15 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float,
     for i in range(rank, n):
         if abs(b[i]) > rel_consistency_tol * b_scale:
             return False
-    x = np.zeros(n)
-    for i in range(rank - 1, -1, -1):
+        b[i] = 0.0  # the free unknowns
+    for i in range(rank - 1, -1, -1):  # the pivoted unknowns, in the swapped column order
         s = b[i]
         for j in range(i + 1, rank):
-            s -= A[i, j] * x[j]
-        x[i] = s / A[i, i]
-    for j in range(n):
-        b[column_of[j]] = x[j]
+            s -= A[i, j] * b[j]
+        b[i] = s / A[i, i]
+    for k in range(rank - 1, -1, -1):  # undo the column swaps, last first
+        c = int(swaps[k])
+        b[k], b[c] = b[c], b[k]
     return True
 
 

@@ -126,18 +126,19 @@ def test_consistent_singular_systems_are_solved_exactly(seed: int) -> None:
     b = A @ x_true
     assert not lu_solve_inplace(A.copy(), b.copy(), 1e-14)
     A_work, x = A.copy(), b.copy()
-    assert solve_consistent_inplace(A_work, x, 1e-14, 1e-10)
+    assert solve_consistent_inplace(A_work, x, np.empty(n), 1e-14, 1e-10)
     np.testing.assert_allclose(A @ x, b, rtol=0, atol=1e-12 * np.abs(b).max())
     # regular systems: the unique solution
     M = rng.standard_normal((n, n))
     y = M @ x_true
-    assert solve_consistent_inplace(M.copy(), y, 1e-14, 1e-10)
+    assert solve_consistent_inplace(M.copy(), y, np.empty(n), 1e-14, 1e-10)
     np.testing.assert_allclose(y, x_true, rtol=1e-9, atol=1e-9)
 
 
 def test_inconsistent_singular_systems_are_refused() -> None:
     A = np.array([[1.0, 2.0], [1.0, 2.0]])
-    assert not solve_consistent_inplace(A.copy(), np.array([1.0, 1.5]), 1e-14, 1e-10)
-    assert solve_consistent_inplace(A.copy(), np.array([1.0, 1.0]), 1e-14, 1e-10)
-    assert solve_consistent_inplace(np.zeros((2, 2)), np.zeros(2), 1e-14, 1e-10)
-    assert not solve_consistent_inplace(np.zeros((2, 2)), np.array([0.0, 1.0]), 1e-14, 1e-10)
+    assert not solve_consistent_inplace(A.copy(), np.array([1.0, 1.5]), np.empty(2), 1e-14, 1e-10)
+    assert solve_consistent_inplace(A.copy(), np.array([1.0, 1.0]), np.empty(2), 1e-14, 1e-10)
+    assert solve_consistent_inplace(np.zeros((2, 2)), np.zeros(2), np.empty(2), 1e-14, 1e-10)
+    assert not solve_consistent_inplace(np.zeros((2, 2)), np.array([0.0, 1.0]), np.empty(2),
+                                        1e-14, 1e-10)

@@ -354,12 +354,13 @@ def _levenberg_marquardt_step(
 
 @njit(cache=True)
 def _search_direction(
-    J: FloatArray, phi: FloatArray, psi: float, H: FloatArray, d: FloatArray, grad: FloatArray
+    J: FloatArray, phi: FloatArray, psi: float, H: FloatArray, d: FloatArray, grad: FloatArray,
+    work: FloatArray,
 ) -> tuple[float, bool]:
     """Fill d with a descent direction of psi = |phi|^2 / 2.
 
-    Newton (``J d = -phi``) if J is regular and that is a descent direction, else
-    Levenberg-Marquardt, else steepest descent.
+    Newton (``J d = -phi``) if J is regular, or singular but consistent, and that is a descent
+    direction, else Levenberg-Marquardt, else steepest descent. work: (n,) scratch.
 
     Returns:
         (slope, is_newton): the slope grad . d (0 when grad = J^T phi = 0) and whether d is the
@@ -385,7 +386,7 @@ def _search_direction(
             for j in range(n):
                 H[i, j] = J[i, j]
             d[i] = -phi[i]
-        solved = solve_consistent_inplace(H, d, _PIVOT_TOL, _CONSISTENCY_TOL)
+        solved = solve_consistent_inplace(H, d, work, _PIVOT_TOL, _CONSISTENCY_TOL)
     if solved:
         slope = 0.0
         d_norm2 = 0.0
@@ -463,7 +464,7 @@ def newton_ac_core(
             center_norm = np.sqrt(2.0 * psi)
             sub_steps = 0
         _assemble_jacobian(W, A, B, sigma, rho, J)
-        slope, is_newton = _search_direction(J, phi, psi, H, d, grad)
+        slope, is_newton = _search_direction(J, phi, psi, H, d, grad, Wd)
         for i in range(n):
             acc = sigma * d[i] / rho[i // 3]
             for j in range(n):
