@@ -3,10 +3,17 @@
 Normalised torques in [-1, 1] are scaled by the scene's bound; the brake is either thresholded
 from a Box component ("box"), a Discrete choice ("hybrid") or a continuous Tresca bound
 ("brake_force"). Out-of-range values are clipped; NaN/inf or wrong shapes raise ValueError.
+
+Decoding is split in two so that an env step costs one compiled call: ``TorqueBrakeActions
+.levels`` checks the action's type and shape in Python and returns the normalised levels
+(N, width) (the caller's array itself when it is already a float array of the right shape);
+``decode_levels``, compiled and called first inside the env's step kernel, checks them for
+NaN/inf and writes the torques and brake bounds.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -16,18 +23,9 @@ from numba import njit
 from mdi_envs._types import FloatArray
 
 ACTION_MODES = ("box", "hybrid", "brake_force")
-_FAST_DTYPES = (np.dtype(np.float32), np.dtype(np.float64))
-
-
-def torque_brake_space(action_mode: str, num_torques: int, has_brake: bool = True
-                       ) -> spaces.Space[Any]:  # fmt: skip
-    """The single-copy action space: torques first, then the brake component (if any)."""
-    if not has_brake:
-        return spaces.Box(-1.0, 1.0, (num_torques,), np.float32)
-    if action_mode == "hybrid":
-        return spaces.Tuple((spaces.Discrete(2), spaces.Box(-1.0, 1.0, (num_torques,),
-                                                            np.float32)))  # fmt: skip
-    return spaces.Box(-1.0, 1.0, (num_torques + 1,), np.float32)
+_FAST_DTYPE_CHARS = "fd"  # float32, float64: passed to the compiled decoding as they are
+RULE_NO_BRAKE, RULE_BOX, RULE_BRAKE_FORCE, RULE_HYBRID = 0, 1, 2, 3
+"""How ``decode_levels`` reads the brake level (see ``TorqueBrakeActions.rule``)."""
 
 
 def _batch_array(value: Any, shape: tuple[int, ...], name: str) -> FloatArray:
@@ -44,73 +42,108 @@ def _batch_array(value: Any, shape: tuple[int, ...], name: str) -> FloatArray:
     return array
 
 
-@njit(cache=True)
-def _decode(levels: FloatArray, num_torques: int, brake_rule: int, max_torque: float,
-            max_brake_torque: float, tau: FloatArray, brake: FloatArray) -> bool:  # fmt: skip
-    """Write tau and brake from normalised levels (N, d); False if any level is not finite.
+@dataclass(frozen=True)
+class TorqueBrakeActions:
+    """A scene's action coding: ``num_torques`` normalised torques, then an optional brake.
 
-    brake_rule: 0 no brake column, 1 ideal iff level > 0 ("box"), 2 the Tresca bound
-    max_brake_torque (level + 1) / 2 ("brake_force"), 3 ideal iff level == 1 ("hybrid").
+    Attributes:
+        mode: "box" (brake engaged, ideal, iff its Box component > 0), "hybrid" (a Discrete
+            brake choice with a Box of torques) or "brake_force" (the Tresca bound
+            max_brake_torque (b + 1) / 2 from the Box component b). Without a brake: "box".
+        num_torques: torque (or force) inputs m.
+        has_brake: whether the scene has a brake (one).
+        max_torque: bound of every input [N m or N]: a normalised level 1 gives this.
+        max_brake_torque: the Tresca bound at level 1 of "brake_force" [N m].
     """
-    for i in range(levels.shape[0]):
-        for j in range(levels.shape[1]):
-            if not np.isfinite(levels[i, j]):
-                return False
+
+    mode: str
+    num_torques: int
+    has_brake: bool
+    max_torque: float
+    max_brake_torque: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.mode not in ACTION_MODES:
+            raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {self.mode!r}")
+        if self.mode != "box" and not self.has_brake:
+            raise ValueError(f"action_mode {self.mode!r} needs a scene with a brake")
+
+    @property
+    def width(self) -> int:
+        """Entries of one copy's normalised levels: the torques, then the brake (if any)."""
+        return self.num_torques + (1 if self.has_brake else 0)
+
+    @property
+    def rule(self) -> int:
+        """The ``RULE_*`` code of ``decode_levels`` for this mode."""
+        if not self.has_brake:
+            return RULE_NO_BRAKE
+        return {"box": RULE_BOX, "brake_force": RULE_BRAKE_FORCE, "hybrid": RULE_HYBRID}[
+            self.mode]
+
+    def space(self) -> spaces.Space[Any]:
+        """The single-copy action space: torques first, then the brake component (if any)."""
+        torques = spaces.Box(-1.0, 1.0, (self.num_torques,), np.float32)
+        if self.mode == "hybrid":
+            return spaces.Tuple((spaces.Discrete(2), torques))
+        return spaces.Box(-1.0, 1.0, (self.width,), np.float32)
+
+    def levels(self, actions: Any, num_copies: int) -> np.ndarray:
+        """A batch of actions as normalised levels, (num_copies, width) or (width,) for one copy.
+
+        A float32/float64 array of that shape is returned as it is (no copy); anything else
+        is converted to float64. NaN/inf are left for ``decode_levels`` to find.
+
+        Raises:
+            ValueError: wrong shape, a non-numeric action, or a hybrid brake choice other
+                than 0 or 1.
+        """
+        if self.mode == "hybrid":
+            if not (isinstance(actions, tuple) and len(actions) == 2):
+                raise ValueError("a hybrid action is a tuple (brake choice in {0, 1}, torques)")
+            choice = _batch_array(actions[0], (num_copies,), "brake choice")
+            if not np.isin(choice, (0.0, 1.0)).all():
+                raise ValueError(f"brake choice must be 0 or 1, got {choice.tolist()}")
+            levels = np.empty((num_copies, self.width))
+            levels[:, : self.num_torques] = _batch_array(
+                actions[1], (num_copies, self.num_torques), "torque action")
+            levels[:, self.num_torques] = choice
+            return levels
+        if (type(actions) is np.ndarray and actions.dtype.char in _FAST_DTYPE_CHARS
+                and actions.size == num_copies * self.width and actions.ndim <= 2
+                and actions.shape[-1] == self.width):
+            return actions
+        return _batch_array(actions, (num_copies, self.width), "action")
+
+
+@njit(inline="always")
+def decode_levels(levels: Any, num_torques: int, rule: int, max_torque: float,
+                  max_brake_torque: float, tau: FloatArray, brake: FloatArray) -> bool:  # fmt: skip
+    """Write tau (N, m) and brake (N, 1 or 0) from normalised levels (N, m + 1 or m), in place.
+
+    ``levels`` may also be flat, (N * width,). Returns False, writing nothing, if any level is
+    NaN/inf. Torques: clip(level, -1, 1) max_torque. Brake by ``rule``: RULE_BOX inf (ideal)
+    iff level > 0 else 0 (released); RULE_BRAKE_FORCE the Tresca bound max_brake_torque
+    (clip(level, -1, 1) + 1) / 2; RULE_HYBRID inf iff level == 1 else 0.
+    """
+    flat = levels.ravel()
+    for value in flat:
+        if not np.isfinite(value):
+            return False
+    width = flat.size // tau.shape[0]
+    for i in range(tau.shape[0]):
         for j in range(num_torques):
-            tau[i, j] = max_torque * min(max(levels[i, j], -1.0), 1.0)
-        if brake_rule == 0:
+            tau[i, j] = max_torque * min(max(flat[i * width + j], -1.0), 1.0)
+        if rule == RULE_NO_BRAKE:
             continue
-        level = levels[i, num_torques]
-        if brake_rule == 2:
+        level = flat[i * width + num_torques]
+        if rule == RULE_BRAKE_FORCE:
             brake[i, 0] = max_brake_torque * 0.5 * (min(max(level, -1.0), 1.0) + 1.0)
-        elif brake_rule == 1:
+        elif rule == RULE_BOX:
             brake[i, 0] = np.inf if level > 0.0 else 0.0
         else:
             brake[i, 0] = np.inf if level == 1.0 else 0.0
     return True
 
 
-def decode_torque_and_brake(
-    actions: Any,
-    action_mode: str,
-    max_torque: float,
-    max_brake_torque: float,
-    tau: FloatArray,
-    brake: FloatArray,
-) -> None:
-    """Decode a batch of actions into ``tau`` (N, m) [N m] and ``brake`` (N, 0 or 1), in place.
-
-    Torques: the normalised values clipped to [-1, 1] times ``max_torque``. Brake: "box" inf
-    (ideal) if its component > 0 else 0 (released); "hybrid" inf for choice 1 else 0;
-    "brake_force" the bound max_brake_torque (b + 1) / 2 with b clipped to [-1, 1].
-
-    Raises:
-        ValueError: wrong shape, NaN/inf, or a hybrid brake choice other than 0 or 1.
-    """
-    num_copies, num_torques = tau.shape
-    has_brake = brake.shape[1] > 0
-    if has_brake and action_mode == "hybrid":
-        if not (isinstance(actions, tuple) and len(actions) == 2):
-            raise ValueError("a hybrid action is a tuple (brake choice in {0, 1}, torques)")
-        choice = _batch_array(actions[0], (num_copies,), "brake choice")
-        if not np.isin(choice, (0.0, 1.0)).all():
-            raise ValueError(f"brake choice must be 0 or 1, got {choice.tolist()}")
-        levels = np.empty((num_copies, num_torques + 1))
-        levels[:, :num_torques] = _batch_array(actions[1], (num_copies, num_torques),
-                                               "torque action")  # fmt: skip
-        levels[:, num_torques] = choice
-        rule = 3
-    else:
-        width = num_torques + (1 if has_brake else 0)
-        if (type(actions) is np.ndarray and actions.dtype in _FAST_DTYPES
-                and actions.size == num_copies * width
-                and actions.shape[-1] == width and actions.ndim <= 2):
-            levels = actions.reshape(num_copies, width)  # a view: no conversion, no copy
-        else:
-            levels = _batch_array(actions, (num_copies, width), "action")
-        rule = 0 if not has_brake else (1 if action_mode == "box" else 2)
-    if not _decode(levels, num_torques, rule, max_torque, max_brake_torque, tau, brake):
-        raise ValueError(f"action contains NaN or inf entries: {levels.tolist()}")
-
-
-__all__ = ["ACTION_MODES", "decode_torque_and_brake", "torque_brake_space"]
+__all__ = ["ACTION_MODES", "TorqueBrakeActions", "decode_levels"]

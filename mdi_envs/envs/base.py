@@ -16,8 +16,9 @@ every task:
     reward_goal      = -goal_weight * distance_to_goal, once, when a fixed horizon ends.
 
 The per-copy scene functions (observation, goal distance, success) are plain Python on scalars
-and small arrays, compiled with numba into one batched kernel per task class, so that a single
-``env.step`` costs two compiled calls (physics, then rewards and observations).
+and small arrays, compiled with numba into one batched kernel per task class, so that an
+``env.step`` costs one compiled call (action decoding, physics, rewards, observations and info)
+with six array arguments: the batch state lives in one flat buffer (``BatchState``).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from gymnasium.vector.utils import batch_space
 from numba import njit
 
 from mdi_envs._types import BoolArray, FloatArray
+from mdi_envs.envs._actions import TorqueBrakeActions, decode_levels
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.mechanics.parameters import require_nonnegative, require_positive
 from mdi_envs.stepping._kernel import (
@@ -77,10 +79,11 @@ def build_parameters(parameters: Any, defaults: type[Any], **overrides: Any) -> 
 class MoreauJeanTask:
     """Scene logic of one environment family, batched over N copies.
 
-    Subclasses set ``MODEL``, ``NUM_OBSERVATIONS`` and ``OBJECTIVE_OPTIONS``, build the two
-    single-copy spaces and implement the compiled ``observe_one``, ``distance_one`` and
-    ``success_one`` with their ``constants``, plus ``initial_state``, ``decode_actions`` and
-    ``info_one`` with ``INFO_KEYS``. Arrays are float64 of shape (N, ...), observations float32.
+    Subclasses set ``MODEL``, ``NUM_OBSERVATIONS`` and ``OBJECTIVE_OPTIONS``, the action coding
+    ``actions`` with ``single_action_space = actions.space()``, the observation space, and
+    implement the compiled ``observe_one``, ``distance_one`` and ``success_one`` with their
+    ``constants``, plus ``initial_state`` and ``info_one`` with ``INFO_KEYS``. Arrays are
+    float64 of shape (N, ...), observations float32.
 
     Args:
         parameters: the model's parameter dataclass (default: its defaults).
@@ -102,6 +105,8 @@ class MoreauJeanTask:
     OBJECTIVE_OPTIONS: ClassVar[tuple[str, ...]] = ("time",)
     single_observation_space: spaces.Space[Any]
     single_action_space: spaces.Space[Any]
+    actions: TorqueBrakeActions
+    """The action coding (space, scaling, brake rule); set by each task's ``__init__``."""
 
     def __init__(
         self,
@@ -119,11 +124,10 @@ class MoreauJeanTask:
         shortcuts: StepShortcuts | None = None,
         locate_impacts: bool = False,
     ) -> None:
-        self._constants_cache: FloatArray | None = None
+        self._task_array_cache: FloatArray | None = None
         self._kernels: tuple[Any, Any, Any] | None = None
         self._info_keys = BASE_INFO_KEYS + self.INFO_KEYS
-        self._typed_keys = tuple(
-            (key, _INFO_TYPES[key]) for key in self._info_keys if key in _INFO_TYPES)
+        self._info_of = _info_builder(self._info_keys)
         _require(isinstance(frame_skip, (int, np.integer)) and frame_skip >= 1,
                  f"frame_skip must be a positive integer, got {frame_skip!r}")  # fmt: skip
         _require(objective in self.OBJECTIVE_OPTIONS,
@@ -153,21 +157,37 @@ class MoreauJeanTask:
         self.goal_weight = require_nonnegative("goal_weight", goal_weight)
         self.effort_weight = require_nonnegative("effort_weight", effort_weight)
         self.reset_noise_scale = require_nonnegative("reset_noise_scale", reset_noise_scale)
-        self._settings = np.array([
-            self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
-            self.effort_weight, self.goal_weight, self.shaping_weight, self.shaping_discount,
-            *self.stepper.compiled_step_batch[1],
-        ])  # read by the compiled ``advance`` (see ``_compiled``), the model's record last
 
     def __getstate__(self) -> dict[str, Any]:
-        """Pickle without the compiled kernels (rebuilt on first use)."""
-        return {**self.__dict__, "_kernels": None}
+        """Pickle without the compiled kernels and the info builder (rebuilt when unpickled)."""
+        return {**self.__dict__, "_kernels": None, "_info_of": None}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._info_of = _info_builder(self._info_keys)
+
+    @property
+    def _task_array(self) -> FloatArray:
+        """Everything the compiled ``advance`` reads of the task, in one float64 array.
+
+        (time_step, frame_skip, dt, horizon steps, effort_weight, goal_weight, shaping_weight,
+        shaping_discount, action rule, max_torque, max_brake_torque), then the model's
+        parameter record, then the scene constants ``c`` (see ``_compiled``).
+        """
+        if self._task_array_cache is None:
+            coding = self.actions
+            self._task_array_cache = np.array([
+                self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
+                self.effort_weight, self.goal_weight, self.shaping_weight,
+                self.shaping_discount, coding.rule, coding.max_torque, coding.max_brake_torque,
+                *self.stepper.compiled_step_batch[1], *np.asarray(self.constants(), np.float64),
+            ])  # fmt: skip
+        return self._task_array_cache
 
     @property
     def _constants(self) -> FloatArray:
-        if self._constants_cache is None:
-            self._constants_cache = np.ascontiguousarray(self.constants(), dtype=np.float64)
-        return self._constants_cache
+        """The scene constants ``c`` (a view into ``_task_array``)."""
+        return self._task_array[SETTINGS_SIZE + len(self.stepper.compiled_step_batch[1]):]
 
     # -- scene-specific, implemented by each task ------------------------------------------
     # The three static methods below are compiled by numba (nopython): plain arithmetic on
@@ -197,10 +217,6 @@ class MoreauJeanTask:
         """One copy's start (q (n,), u (n,)), drawn from ``rng`` only."""
         raise NotImplementedError
 
-    def decode_actions(self, actions: Any, state: BatchState) -> None:
-        """Validate a batch of actions and write ``state.tau`` [N m] and ``state.brake``."""
-        raise NotImplementedError
-
     INFO_KEYS: ClassVar[tuple[str, ...]] = ()
 
     @staticmethod
@@ -218,22 +234,23 @@ class MoreauJeanTask:
         """Names of the ``info`` entries of a step, in the order of ``state.info`` columns."""
         return self._info_keys
 
-    def advance(self, state: BatchState) -> None:
-        """Step the physics of every copy under ``state.tau`` and ``state.brake``, then the
-        rewards, observations and info columns (all written into ``state``).
+    def advance(self, state: BatchState, actions: Any) -> None:
+        """Decode ``actions`` (a batch, see ``actions.levels``) into ``state.tau`` [N m] and
+        ``state.brake``, step the physics of every copy, then the rewards, observations and
+        info columns (all written into ``state``), in one compiled call.
 
         Raises:
+            ValueError: a wrong shape or NaN/inf in ``actions`` (``state`` is left unchanged).
             RuntimeError: the physics produced a non-finite state.
         """
+        levels = self.actions.levels(actions, state.num_copies)
         if self._kernels is None:
-            self._kernels = _compiled(type(self), *self.stepper.compiled_step_batch[:2])
-        finite = self._kernels[0](
-            state.q, state.u, state.tau, state.brake, state.impulses, state.physics,
-            self._settings, self._constants, state.elapsed_steps, state.effort,
-            state.potential, state.terminated, state.reward, state.obs, state.info,
-            *self.stepper.compiled_step_batch[2],
-        )
-        if not finite:
+            self._kernels = _compiled(self)
+        outcome = self._kernels[0](levels, state.buffer, state.obs, self._task_array,
+                                   *self.stepper.compiled_step_batch[2])  # fmt: skip
+        if outcome == ADVANCE_ACTION_NOT_FINITE:
+            raise ValueError(f"action contains NaN or inf entries: {np.asarray(levels).tolist()}")
+        if outcome == ADVANCE_STATE_NOT_FINITE:
             raise RuntimeError(
                 "the physics step produced a non-finite state (solver status codes "
                 f"{state.physics[:, INFO_STATUS].tolist()}); please report this with the seed"
@@ -245,15 +262,12 @@ class MoreauJeanTask:
                 for k, key in enumerate(self.info_keys)}  # fmt: skip
 
     def info_dict(self, state: BatchState) -> dict[str, Any]:
-        """Copy 0's last-step info as name -> Python scalar."""
-        info = dict(zip(self._info_keys, state.info[0].tolist(), strict=True))
-        for key, kind in self._typed_keys:
-            info[key] = kind(info[key])
-        return info
+        """Copy 0's last-step info as name -> Python scalar (bool and int entries typed)."""
+        return self._info_of(state.info[0].tolist())
 
     def observe(self, state: BatchState) -> Any:
         """Recompute every copy's observation into ``state.obs`` and return it."""
-        observe_all = _compiled(type(self), *self.stepper.compiled_step_batch[:2])[1]
+        observe_all = _compiled(self)[1]
         observe_all(state.q, state.u, state.brake, state.elapsed_steps, self.num_horizon_steps,
                     self.dt, self._constants, state.obs)
         return state.obs
@@ -273,7 +287,7 @@ class MoreauJeanTask:
 
     def update_potential(self, state: BatchState, index: int) -> None:
         """Phi of copy ``index`` after its state was set from outside the step."""
-        distance_one = _compiled(type(self), *self.stepper.compiled_step_batch[:2])[2]
+        distance_one = _compiled(self)[2]
         distance = distance_one(state.q[index], state.u[index], self._constants)
         state.potential[index] = -self.shaping_weight * distance
 
@@ -282,35 +296,72 @@ class MoreauJeanTask:
         return rng.uniform(-self.reset_noise_scale, self.reset_noise_scale, size)
 
 
+def state_fields(task: MoreauJeanTask) -> tuple[tuple[str, int | None], ...]:
+    """(name, width) of the ``BatchState`` arrays inside its buffer, in order.
+
+    Width w makes an (N, w) array, None an (N,) array (one number per copy).
+    """
+    model, stepper = task.MODEL, task.stepper
+    return (("q", model.NUM_DOFS), ("u", model.NUM_DOFS), ("tau", model.NUM_INPUTS),
+            ("brake", model.NUM_BRAKES), ("impulses", stepper.num_impulses),
+            ("physics", stepper.info_size), ("info", len(task.info_keys)),
+            ("elapsed_steps", None), ("effort", None), ("potential", None),
+            ("terminated", None), ("reward", None))  # fmt: skip
+
+
 class BatchState:
     """The mutable state of N copies: physics arrays advanced in place, episode bookkeeping.
+
+    All arrays but ``obs`` are C-contiguous float64 views into one flat ``buffer``, laid out
+    by ``state_fields`` (array after array), so that the compiled step takes the whole state
+    as one argument. Assign into them (``state.q[i] = ...``), never rebind them.
 
     Attributes:
         q, u: (N, n) coordinates and velocities. tau: (N, m) last torques [N m].
         brake: (N, k) last brake bounds (0 released, inf ideal). elapsed_steps: (N,) env
-        steps. effort: (N,) integral of sum(tau^2) [N^2 m^2 s]. potential: (N,) Phi of the
-        current state. terminated: (N,) whether the last step ended the episode. reward (N,),
-        obs (N, NUM_OBSERVATIONS) float32, info (N, len(info_keys)): the last step's outputs.
-        impulses, physics: the stepper's outputs of the last physics step (the impulses also
-        warm-start the next step's solver for spatial contacts; zero after a reset).
+        steps (whole numbers). effort: (N,) integral of sum(tau^2) [N^2 m^2 s]. potential:
+        (N,) Phi of the current state. terminated: (N,) 1.0 if the last step ended the episode
+        else 0.0. reward (N,), obs (N, NUM_OBSERVATIONS) float32, info (N, len(info_keys)):
+        the last step's outputs. impulses, physics: the stepper's outputs of the last physics
+        step (the impulses also warm-start the next step's solver for spatial contacts; zero
+        after a reset).
     """
 
+    q: FloatArray
+    u: FloatArray
+    tau: FloatArray
+    brake: FloatArray
+    impulses: FloatArray
+    physics: FloatArray
+    info: FloatArray
+    elapsed_steps: FloatArray
+    effort: FloatArray
+    potential: FloatArray
+    terminated: FloatArray
+    reward: FloatArray
+
     def __init__(self, task: MoreauJeanTask, num_copies: int) -> None:
-        model = task.MODEL
         self.num_copies = num_copies
-        self.q = np.zeros((num_copies, model.NUM_DOFS))
-        self.u = np.zeros((num_copies, model.NUM_DOFS))
-        self.tau = np.zeros((num_copies, model.NUM_INPUTS))
-        self.brake = np.zeros((num_copies, model.NUM_BRAKES))
-        self.elapsed_steps = np.zeros(num_copies, np.int64)
-        self.effort = np.zeros(num_copies)
-        self.potential = np.zeros(num_copies)
-        self.terminated = np.zeros(num_copies, np.bool_)
-        self.reward = np.zeros(num_copies)
+        self._fields = state_fields(task)
+        per_copy = sum(1 if width is None else width for _, width in self._fields)
+        self.buffer = np.zeros(num_copies * per_copy)
         self.obs = np.zeros((num_copies, task.NUM_OBSERVATIONS), np.float32)
-        self.info = np.zeros((num_copies, len(task.info_keys)))
-        self.impulses = np.zeros((num_copies, task.stepper.num_impulses))
-        self.physics = np.zeros((num_copies, task.stepper.info_size))
+        self._take_views()
+
+    def _take_views(self) -> None:
+        start = 0
+        for name, width in self._fields:
+            view = self.buffer[start:start + self.num_copies * (1 if width is None else width)]
+            setattr(self, name, view if width is None else view.reshape(self.num_copies, width))
+            start += view.size
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle the buffer, not its views (unpickled views would be copies)."""
+        return {key: self.__dict__[key] for key in ("num_copies", "_fields", "buffer", "obs")}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._take_views()
 
 
 class MoreauJeanEnv(gym.Env[Any, Any]):
@@ -368,12 +419,12 @@ class MoreauJeanEnv(gym.Env[Any, Any]):
         """Advance by ``dt``; see the class docstring for rewards and ``info``."""
         if not self._has_reset:
             raise gym.error.ResetNeeded("call reset() before step()")
-        self.task.decode_actions(action, self.state)
-        self.task.advance(self.state)
+        state = self.state
+        self.task.advance(state, action)
         if self.render_mode == "human":
             self.render()
-        return (self.state.obs[0].copy(), float(self.state.reward[0]),
-                bool(self.state.terminated[0]), False, self.task.info_dict(self.state))
+        return (state.obs[0].copy(), float(state.reward[0]), bool(state.terminated[0]), False,
+                self.task.info_dict(state))
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[Any, dict[str, Any]]:  # fmt: skip
@@ -483,11 +534,10 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         """Advance every copy by ``dt`` (copies that ended last step are reset instead)."""
         if not self._rngs:
             raise gym.error.ResetNeeded("call reset() before step()")
-        self.task.decode_actions(actions, self.state)
-        self.task.advance(self.state)
+        self.task.advance(self.state, actions)
         reward = self.state.reward
         info = self.task.info_arrays(self.state)
-        terminated = self.state.terminated.copy()
+        terminated = self.state.terminated != 0.0
         if self.max_episode_steps is not None:
             truncated = self.state.elapsed_steps >= self.max_episode_steps
         else:
@@ -512,29 +562,79 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         return self.state.obs.copy(), reward, terminated, truncated, infos
 
 
-_COMPILED: dict[tuple[type[MoreauJeanTask], Any, type], tuple[Any, Any, Any]] = {}
-SETTINGS_SIZE = 8
-"""Entries of ``MoreauJeanTask._settings`` before the model's parameter record."""
+_COMPILED: dict[tuple[Any, ...], tuple[Any, Any, Any]] = {}
+SETTINGS_SIZE = 11
+"""Entries of ``MoreauJeanTask._task_array`` before the model's parameter record."""
+ADVANCE_OK, ADVANCE_ACTION_NOT_FINITE, ADVANCE_STATE_NOT_FINITE = 0, 1, 2
+"""Outcomes of the compiled ``advance``."""
 
 
-def _compiled(task: type[MoreauJeanTask], step_batch: Any, record: Any
-              ) -> tuple[Any, Any, Any]:  # fmt: skip
-    """The batched kernels of ``task`` on the stepper kernel ``step_batch`` whose parameter
-    record is like ``record`` (compiled once per task, kernel and record type, per process).
+def _make_state_carver(fields: tuple[tuple[str, int | None], ...]) -> Any:
+    """A compiled ``carve(buffer, N)``: the ``BatchState`` views of a flat buffer, in order.
 
-    Returns (advance, observe_all, distance_one). ``advance`` runs the physics substeps and
-    then the rewards, observations and info of every copy in one compiled call (one dispatch
-    from Python per env step). Its arguments are flat arrays only, the stepper's workspace
-    last, unpacked: the record is rebuilt inside from the settings array, since each tuple
-    argument costs microseconds of typing per call.
+    Generated so that every width is a compile-time constant; the views are those
+    ``BatchState`` takes in Python.
     """
-    key = (task, step_batch, type(record))
+    lines = ["def carve(buffer, N):"]
+    start = "0"
+    for name, width in fields:
+        end = f"{start} + N * {1 if width is None else width}"
+        shape = "" if width is None else f".reshape((N, {width}))"
+        lines.append(f"    {name} = buffer[{start}:{end}]{shape}")
+        start = end
+    lines.append(f"    return ({', '.join(name for name, _ in fields)},)")
+    namespace: dict[str, Any] = {}
+    exec("\n".join(lines), namespace)  # noqa: S102 - generated from the fields' widths
+    return njit(inline="always")(namespace["carve"])
+
+
+def _info_builder(keys: tuple[str, ...]) -> Any:
+    """A function from one info row (a list of floats, in ``keys`` order) to the info dict.
+
+    Generated as a single dict display with the bool and int entries converted inline (a
+    step's info dict then costs about a microsecond). Cached per ``keys``.
+    """
+    if keys not in _INFO_BUILDERS:
+        entries = []
+        for k, key in enumerate(keys):
+            kind = _INFO_TYPES.get(key, float)
+            value = (f"row[{k}] != 0.0" if kind is bool else f"int(row[{k}])" if kind is int
+                     else f"row[{k}]")  # fmt: skip
+            entries.append(f"{key!r}: {value}")
+        namespace: dict[str, Any] = {}
+        exec("def info_of(row):\n    return {" + ", ".join(entries) + "}",  # noqa: S102
+             namespace)  # fmt: skip
+        _INFO_BUILDERS[keys] = namespace["info_of"]
+    return _INFO_BUILDERS[keys]
+
+
+_INFO_BUILDERS: dict[tuple[str, ...], Any] = {}
+
+
+def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any]:
+    """The batched kernels of ``task``: compiled once per task class, stepper kernel, parameter
+    record type and state layout, per process.
+
+    Returns (advance, observe_all, distance_one). ``advance(levels, buffer, obs, task_array,
+    *workspace)`` decodes the actions, runs the physics substeps and then the rewards,
+    observations and info of every copy in one compiled call (one dispatch from Python per
+    env step), and returns an ``ADVANCE_*`` outcome. Its arguments are six arrays (each costs
+    about 0.1 us to type per call, a tuple several): the state is one buffer carved inside,
+    the parameter record is rebuilt inside from the task array.
+    """
+    step_batch, record = task.stepper.compiled_step_batch[:2]
+    fields = state_fields(task)
+    key = (type(task), step_batch, type(record), fields)
     if key in _COMPILED:
         return _COMPILED[key]
-    fields = ", ".join(f"settings[{SETTINGS_SIZE + i}]" for i in range(len(record)))
+    record_entries = ", ".join(f"settings[{SETTINGS_SIZE + i}]" for i in range(len(record)))
     namespace: dict[str, Any] = {"Record": type(record)}
-    exec(f"def read_record(settings):\n    return Record({fields})", namespace)  # noqa: S102
+    exec(f"def read_record(settings):\n    return Record({record_entries})",  # noqa: S102
+         namespace)  # fmt: skip
     read_record = njit(inline="always")(namespace["read_record"])
+    carve_state = _make_state_carver(fields)
+    constants_start = SETTINGS_SIZE + len(record)
+    num_torques = task.MODEL.NUM_INPUTS
     observe_one = njit(task.observe_one)
     distance_one = njit(task.distance_one)
     success_one = njit(task.success_one)
@@ -569,7 +669,7 @@ def _compiled(task: type[MoreauJeanTask], step_batch: Any, record: Any
             shaping = discount * phi - potential[i]
             potential[i] = phi
             reward[i] = objective + shaping + goal
-            terminated[i] = ended
+            terminated[i] = 1.0 if ended else 0.0
             # info: BASE_INFO_KEYS, then the scene's INFO_KEYS
             row[0] = objective
             row[1] = shaping
@@ -587,13 +687,19 @@ def _compiled(task: type[MoreauJeanTask], step_batch: Any, record: Any
         return finite
 
     @njit
-    def advance(q, u, tau, brake, impulses, physics, settings, c, elapsed,  # noqa: ANN001
-                effort, potential, terminated, reward, obs, info, *workspace):
+    def advance(levels, buffer, obs, settings, *workspace):  # noqa: ANN001
+        (q, u, tau, brake, impulses, physics, info, elapsed, effort, potential, terminated,
+         reward) = carve_state(buffer, obs.shape[0])
+        if not decode_levels(levels, num_torques, int(settings[8]), settings[9], settings[10],
+                             tau, brake):  # fmt: skip
+            return ADVANCE_ACTION_NOT_FINITE
         step_batch(q, u, tau, brake, settings[0], read_record(settings), int(settings[1]),
                    impulses, physics, workspace)
-        return evaluate(q, u, tau, brake, impulses, physics, c, settings[2], int(settings[3]),
-                        settings[4], settings[5], settings[6], settings[7], elapsed, effort,
-                        potential, terminated, reward, obs, info)
+        finite = evaluate(q, u, tau, brake, impulses, physics, settings[constants_start:],
+                          settings[2], int(settings[3]), settings[4], settings[5], settings[6],
+                          settings[7], elapsed, effort, potential, terminated, reward, obs,
+                          info)  # fmt: skip
+        return ADVANCE_OK if finite else ADVANCE_STATE_NOT_FINITE
 
     @njit
     def observe_all(q, u, brake, elapsed, horizon, dt, c, obs):  # noqa: ANN001

@@ -11,13 +11,8 @@ import numpy as np
 from gymnasium import spaces
 
 from mdi_envs._types import FloatArray
-from mdi_envs.envs._actions import ACTION_MODES, decode_torque_and_brake, torque_brake_space
-from mdi_envs.envs.base import (
-    BatchState,
-    MoreauJeanEnv,
-    MoreauJeanTask,
-    MoreauJeanVectorEnv,
-)
+from mdi_envs.envs._actions import TorqueBrakeActions
+from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulator
 from mdi_envs.mechanics.parameters import require_positive
 from mdi_envs.tasks import MANIPULATOR_TASK, wrap_angle
@@ -46,10 +41,11 @@ class BlockableManipulatorTask(MoreauJeanTask):
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
         self.max_torque = require_positive("max_torque", max_torque)
         self.max_brake_torque = require_positive("max_brake_torque", max_brake_torque)
-        if action_mode not in ACTION_MODES:
-            raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
+        # motor torque [N m] and brake bound (see the env's Action Space)
+        self.actions = TorqueBrakeActions(action_mode, 1, True, self.max_torque,
+                                          self.max_brake_torque)  # fmt: skip
         self.action_mode = action_mode
-        self.single_action_space = torque_brake_space(action_mode, num_torques=1)
+        self.single_action_space = self.actions.space()
         high = np.array([1, 1, 1, 1, np.inf, np.inf, 1], np.float32)  # see observe_one
         low = -high
         low[-1] = 0.0
@@ -59,11 +55,6 @@ class BlockableManipulatorTask(MoreauJeanTask):
         """Rest at alpha = beta = 0, each coordinate and speed perturbed by the reset noise."""
         q = np.array(MANIPULATOR_TASK.initial_q) + self.noise(rng, 2)
         return q, self.noise(rng, 2)
-
-    def decode_actions(self, actions: Any, state: BatchState) -> None:
-        """Motor torque [N m] and brake bound (see the env's Action Space)."""
-        decode_torque_and_brake(actions, self.action_mode, self.max_torque,
-                                self.max_brake_torque, state.tau, state.brake)  # fmt: skip
 
     def constants(self) -> FloatArray:
         """(goal alpha, goal beta, angle tol, speed tol, velocity weight, max brake torque)."""

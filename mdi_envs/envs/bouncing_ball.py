@@ -11,9 +11,8 @@ import numpy as np
 from gymnasium import spaces
 
 from mdi_envs._types import FloatArray
-from mdi_envs.envs._actions import decode_torque_and_brake, torque_brake_space
+from mdi_envs.envs._actions import TorqueBrakeActions
 from mdi_envs.envs.base import (
-    BatchState,
     MoreauJeanEnv,
     MoreauJeanTask,
     MoreauJeanVectorEnv,
@@ -58,7 +57,9 @@ class BouncingBallTask(MoreauJeanTask):
         if not INITIAL_HEIGHT > self.parameters.radius:
             raise ValueError(f"parameter 'radius' must be < the drop height {INITIAL_HEIGHT} m, "
                              f"got {self.parameters.radius!r}")  # fmt: skip
-        self.single_action_space = torque_brake_space("box", num_torques=1, has_brake=False)
+        # horizontal force [N] = max_force * clip(action, -1, 1)
+        self.actions = TorqueBrakeActions("box", 1, False, self.max_force)
+        self.single_action_space = self.actions.space()
         high = np.full(self.NUM_OBSERVATIONS, np.inf, np.float32)
         self.single_observation_space = spaces.Box(-high, high, dtype=np.float32)
 
@@ -66,10 +67,6 @@ class BouncingBallTask(MoreauJeanTask):
         """Rest at (0, 1 m); x and x' plus the reset noise (the height is exact)."""
         noise = self.noise(rng, 2)
         return np.array([noise[0], INITIAL_HEIGHT]), np.array([noise[1], 0.0])
-
-    def decode_actions(self, actions: Any, state: BatchState) -> None:
-        """Horizontal force [N] = max_force * clip(action, -1, 1)."""
-        decode_torque_and_brake(actions, "box", self.max_force, 0.0, state.tau, state.brake)
 
     def constants(self) -> FloatArray:
         """(goal x, radius, gravity, position tol, speed tol, gap tol, velocity weight)."""

@@ -12,8 +12,8 @@ import numpy as np
 from gymnasium import spaces
 
 from mdi_envs._types import FloatArray
-from mdi_envs.envs._actions import decode_torque_and_brake, torque_brake_space
-from mdi_envs.envs.base import BatchState, MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
+from mdi_envs.envs._actions import TorqueBrakeActions
+from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
 from mdi_envs.mechanics.parameters import require_positive
 from mdi_envs.stepping._spatial_kernel import INFO_LIFTED_CONTACTS, INFO_MODE, INFO_RESIDUAL
@@ -50,7 +50,9 @@ class DiffDriveRobotTask(MoreauJeanTask):
                          final_time=DIFF_DRIVE_TASK.effort_final_time,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
         self.max_wheel_torque = require_positive("max_wheel_torque", max_wheel_torque)
-        self.single_action_space = torque_brake_space("box", num_torques=2, has_brake=False)
+        # wheel torques tau_L, tau_R [N m] from the normalised Box action
+        self.actions = TorqueBrakeActions("box", 2, False, self.max_wheel_torque)
+        self.single_action_space = self.actions.space()
         high = np.full(self.NUM_OBSERVATIONS, np.inf, np.float32)
         high[2:4] = 1.0
         low = -high
@@ -65,11 +67,6 @@ class DiffDriveRobotTask(MoreauJeanTask):
         u = np.zeros(5)
         u[:3] = self.noise(rng, 3)
         return q, u
-
-    def decode_actions(self, actions: Any, state: BatchState) -> None:
-        """Wheel torques tau_L, tau_R [N m] from the normalised Box action."""
-        decode_torque_and_brake(actions, "box", self.max_wheel_torque, 0.0, state.tau,
-                                state.brake)  # fmt: skip
 
     def constants(self) -> FloatArray:
         """(goal x, y, phi, the four tolerances, the three distance weights)."""

@@ -11,9 +11,8 @@ import numpy as np
 from gymnasium import spaces
 
 from mdi_envs._types import FloatArray
-from mdi_envs.envs._actions import decode_torque_and_brake, torque_brake_space
+from mdi_envs.envs._actions import TorqueBrakeActions
 from mdi_envs.envs.base import (
-    BatchState,
     MoreauJeanEnv,
     MoreauJeanTask,
     MoreauJeanVectorEnv,
@@ -56,7 +55,9 @@ class SlidingBlockTask(MoreauJeanTask):
         super().__init__(parameters=parameters, time_step=time_step, frame_skip=frame_skip,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
         self.max_force = require_positive("max_force", max_force)
-        self.single_action_space = torque_brake_space("box", num_torques=1, has_brake=False)
+        # force along +s (down-slope) [N] = max_force * clip(action, -1, 1)
+        self.actions = TorqueBrakeActions("box", 1, False, self.max_force)
+        self.single_action_space = self.actions.space()
         high = np.array([np.inf, np.inf, 1.0], np.float32)
         low = np.array([-np.inf, -np.inf, 0.0], np.float32)
         self.single_observation_space = spaces.Box(low, high, dtype=np.float32)
@@ -65,10 +66,6 @@ class SlidingBlockTask(MoreauJeanTask):
         """Rest at s = 0 on the slope (n = 0); s and s' plus the reset noise."""
         noise = self.noise(rng, 2)
         return np.array([noise[0], 0.0]), np.array([noise[1], 0.0])
-
-    def decode_actions(self, actions: Any, state: BatchState) -> None:
-        """Force along +s (down-slope) [N] = max_force * clip(action, -1, 1)."""
-        decode_torque_and_brake(actions, "box", self.max_force, 0.0, state.tau, state.brake)
 
     def constants(self) -> FloatArray:
         """(goal s, position tol, speed tol, velocity weight, stick speed, contact gap)."""

@@ -108,6 +108,7 @@ def test_pickled_env_continues_identically(env_id: str) -> None:
     clone = pickle.loads(pickle.dumps(env))
     action = env.action_space.sample()
     np.testing.assert_array_equal(env.step(action)[0], clone.step(action)[0])
+    np.testing.assert_array_equal(clone.unwrapped.q, env.unwrapped.q)  # views kept live
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS[:2])
@@ -140,12 +141,29 @@ def test_rgb_array_render(env_id: str) -> None:
 @pytest.mark.parametrize("env_id", ENV_IDS)
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_non_finite_action_is_rejected(env_id: str, bad: float) -> None:
+    """The step raises and leaves the state (torques included) as it was."""
     env = make(env_id)
     env.reset(seed=0)
+    env.step(env.action_space.sample())
+    before = env.unwrapped.state.buffer.copy()
     action = np.zeros(env.action_space.shape, np.float32)
     action[0] = bad
     with pytest.raises(ValueError, match="NaN or inf"):
         env.unwrapped.step(action)
+    np.testing.assert_array_equal(env.unwrapped.state.buffer, before)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_non_finite_action_of_one_copy_rejects_the_vector_step(env_id: str) -> None:
+    """A NaN in the last copy's action raises before any copy's state changes."""
+    envs = gym.make_vec(env_id, num_envs=3, vectorization_mode="vector_entry_point")
+    envs.reset(seed=0)
+    before = envs.unwrapped.state.buffer.copy()
+    actions = np.zeros(envs.action_space.shape, np.float32)
+    actions[-1, -1] = np.nan
+    with pytest.raises(ValueError, match="NaN or inf"):
+        envs.step(actions)
+    np.testing.assert_array_equal(envs.unwrapped.state.buffer, before)
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
