@@ -7,6 +7,7 @@ published numbers (Yunt & Glocker, HSCC 2007) sit beside each task for compariso
 
 from __future__ import annotations
 
+import cmath
 import math
 from dataclasses import dataclass
 
@@ -82,7 +83,7 @@ MANIPULATOR_TASK = ManipulatorTask()
 DIFF_DRIVE_TASK = DiffDriveTask()
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def wrap_angle(angle: float) -> float:
     """``angle`` [rad] mapped to [-pi, pi] (compiled: also callable from the env kernels).
 
@@ -93,9 +94,22 @@ def wrap_angle(angle: float) -> float:
     return angle - 2.0 * math.pi * turns
 
 
+@njit(cache=True, inline="always")
+def cos_sin(angle: float) -> tuple[float, float]:
+    """(cos angle, sin angle) for ``angle`` [rad] in one libm call (compiled).
+
+    Through the complex exponential, which glibc evaluates with sincos: the values of
+    ``math.cos`` and ``math.sin`` (bitwise with glibc) in about half their time (the env
+    kernels' observations).
+    """
+    z = cmath.exp(complex(0.0, angle))
+    return z.real, z.imag
+
+
 __all__ = [
     "DIFF_DRIVE_TASK",
     "MANIPULATOR_TASK",
+    "cos_sin",
     "DiffDriveTask",
     "ManipulatorTask",
     "wrap_angle",

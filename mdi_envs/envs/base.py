@@ -635,10 +635,11 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any]:
     carve_state = _make_state_carver(fields)
     constants_start = SETTINGS_SIZE + len(record)
     num_torques = task.MODEL.NUM_INPUTS
-    observe_one = njit(task.observe_one)
-    distance_one = njit(task.distance_one)
-    success_one = njit(task.success_one)
-    info_one = njit(task.info_one)
+    # inlined into ``evaluate``: no call per copy, and one copy's array views stay local
+    observe_one = njit(inline="always")(task.observe_one)
+    distance_one = njit(inline="always")(task.distance_one)
+    success_one = njit(inline="always")(task.success_one)
+    info_one = njit(inline="always")(task.info_one)
 
     @njit
     def evaluate(q, u, tau, brake, impulses, physics, c, dt, horizon, effort_weight,  # noqa: ANN001

@@ -15,7 +15,7 @@ from mdi_envs.envs._actions import TorqueBrakeActions
 from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulator
 from mdi_envs.mechanics.parameters import require_positive
-from mdi_envs.tasks import MANIPULATOR_TASK, wrap_angle
+from mdi_envs.tasks import MANIPULATOR_TASK, cos_sin, wrap_angle
 
 VELOCITY_WEIGHT = 0.3  # [s] weight of the speeds in the goal distance (rad/s -> rad)
 
@@ -65,10 +65,8 @@ class BlockableManipulatorTask(MoreauJeanTask):
     @staticmethod
     def observe_one(q: Any, u: Any, brake: Any, time_left: float, c: Any, out: Any) -> None:
         """(cos a, sin a, cos b, sin b, a', b', brake level in [0, 1])."""
-        out[0] = math.cos(q[0])
-        out[1] = math.sin(q[0])
-        out[2] = math.cos(q[1])
-        out[3] = math.sin(q[1])
+        out[0], out[1] = cos_sin(q[0])
+        out[2], out[3] = cos_sin(q[1])
         out[4] = u[0]
         out[5] = u[1]
         out[6] = min(brake[0] / c[5], 1.0)

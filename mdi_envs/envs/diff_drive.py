@@ -17,7 +17,7 @@ from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEn
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
 from mdi_envs.mechanics.parameters import require_positive
 from mdi_envs.stepping._spatial_kernel import INFO_LIFTED_CONTACTS, INFO_MODE, INFO_RESIDUAL
-from mdi_envs.tasks import DIFF_DRIVE_TASK, wrap_angle
+from mdi_envs.tasks import DIFF_DRIVE_TASK, cos_sin, wrap_angle
 
 HEADING_WEIGHT = 0.5  # [m/rad] weight of the heading error in the goal distance
 VELOCITY_WEIGHT = 0.5  # [s] weight of the chassis speed in the goal distance
@@ -79,11 +79,10 @@ class DiffDriveRobotTask(MoreauJeanTask):
     def observe_one(q: Any, u: Any, brake: Any, time_left: float, c: Any, out: Any) -> None:
         """Goal offset, heading error, body-frame velocity, yaw and wheel rates, time left."""
         heading_error = q[2] - c[2]
-        cos_phi, sin_phi = math.cos(q[2]), math.sin(q[2])
+        cos_phi, sin_phi = cos_sin(q[2])
         out[0] = q[0] - c[0]
         out[1] = q[1] - c[1]
-        out[2] = math.cos(heading_error)
-        out[3] = math.sin(heading_error)
+        out[2], out[3] = cos_sin(heading_error)
         out[4] = cos_phi * u[0] + sin_phi * u[1]
         out[5] = -sin_phi * u[0] + cos_phi * u[1]
         out[6] = u[2]
