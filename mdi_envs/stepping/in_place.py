@@ -2,9 +2,10 @@
 
 ``MoreauJeanStepper.step`` validates and converts its arguments and returns a new
 ``StepResult`` each call (about 10 us from Python); this keeps the state, the inputs, the
-parameters and the outputs in one flat float64 buffer that the compiled step reads and writes,
-so that a step from Python costs one dispatch with a few array arguments (below 1 us for the
-manipulator). The inputs are still screened, inside the compiled call.
+parameters, the outputs and the solver's scratch in one flat float64 buffer that the compiled
+step reads and writes, so that a step from Python costs one dispatch with one array argument
+(below 1 us for the manipulator: numba types each array argument on every call). The inputs
+are still screened, inside the compiled call.
 """
 
 from __future__ import annotations
@@ -28,17 +29,23 @@ _KERNELS: dict[tuple[Any, type], Any] = {}
 
 
 def _buffer_layout(stepper: MoreauJeanStepper) -> list[tuple[str, int]]:
-    """(name, size) of the buffer's parts after the parameter record and dt, in order."""
+    """(name, size) of the buffer's parts after the parameter record and dt, in order.
+
+    Last the step's float and int scratch (``make_workspace``), the int part read through an
+    int64 view of its float64 entries (zero bits: int zeros, as ``make_workspace`` sets them).
+    """
     n, m, k = stepper.num_dofs, stepper.num_inputs, stepper.num_brakes
+    floats, ints = stepper.compiled_step_batch[2]
     return [("q", n), ("u", n), ("tau", m), ("brake", k), ("q_next", n), ("u_next", n),
-            ("impulses", stepper.num_impulses), ("info", stepper.info_size)]
+            ("impulses", stepper.num_impulses), ("info", stepper.info_size),
+            ("float_scratch", floats.size), ("int_scratch", ints.size)]
 
 
 def _make_kernel(stepper: MoreauJeanStepper) -> Any:
-    """Compile ``step_in_place(buffer, *workspace)`` around ``stepper.compiled_step``."""
+    """Compile ``step_in_place(buffer)`` around ``stepper.compiled_step``."""
     record = stepper.compiled_step_batch[1]
     start = len(record) + 1  # the record, then dt
-    lines = ["def step_in_place(buffer, *workspace):",
+    lines = ["def step_in_place(buffer):",
              "    p = Record(" + ", ".join(f"buffer[{i}]" for i in range(len(record))) + ")",
              f"    dt = buffer[{len(record)}]"]
     for name, size in _buffer_layout(stepper):
@@ -48,14 +55,15 @@ def _make_kernel(stepper: MoreauJeanStepper) -> Any:
         "    problem = screen(q, u, tau, brake)",
         "    if problem != 0:",
         "        return problem",
-        "    step(q, u, tau, brake, dt, p, q_next, u_next, impulses, info, workspace)",
+        "    step(q, u, tau, brake, dt, p, q_next, u_next, impulses, info,",
+        "         (float_scratch, int_scratch.view(np.int64)))",
         f"    for i in range({stepper.num_dofs}):",
         "        q[i] = q_next[i]",
         "        u[i] = u_next[i]",
         "    return 0",
     ]
     namespace: dict[str, Any] = {"Record": type(record), "step": stepper.compiled_step,
-                                 "screen": _screen_inputs}
+                                 "screen": _screen_inputs, "np": np}
     exec("\n".join(lines), namespace)  # noqa: S102 - generated from the model's sizes
     return njit(namespace["step_in_place"])
 
@@ -85,7 +93,6 @@ class InPlaceStepper:
         if key not in _KERNELS:
             _KERNELS[key] = _make_kernel(stepper)
         self._kernel = _KERNELS[key]
-        self._workspace = stepper.compiled_step_batch[2]
         layout = _buffer_layout(stepper)
         self._buffer = np.zeros(len(record) + 1 + sum(size for _, size in layout))
         self._buffer[: len(record)] = record
@@ -95,7 +102,7 @@ class InPlaceStepper:
         for _, size in layout:
             views.append(self._buffer[start:start + size])
             start += size
-        self.q, self.u, self.tau, self.brake_bound, _, _, self.impulses, self._info = views
+        self.q, self.u, self.tau, self.brake_bound, _, _, self.impulses, self._info, _, _ = views
         for name, value in (("q", q), ("u", u)):
             array = np.asarray(value, dtype=np.float64)
             if array.shape != (stepper.num_dofs,):
@@ -109,7 +116,7 @@ class InPlaceStepper:
         Raises:
             ValueError: NaN/inf in q, u or tau, or a negative/NaN brake bound (state kept).
         """
-        problem = self._kernel(self._buffer, *self._workspace)
+        problem = self._kernel(self._buffer)
         if problem:
             raise ValueError(_INPUT_PROBLEMS[problem])
 
