@@ -24,6 +24,7 @@ with six array arguments: the batch state lives in one flat buffer (``BatchState
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -125,7 +126,7 @@ class MoreauJeanTask:
         locate_impacts: bool = False,
     ) -> None:
         self._task_array_cache: FloatArray | None = None
-        self._kernels: tuple[Any, Any, Any] | None = None
+        self._kernels: tuple[Any, Any, Any, Any] | None = None
         self._info_keys = BASE_INFO_KEYS + self.INFO_KEYS
         self._info_of = _info_builder(self._info_keys)
         _require(isinstance(frame_skip, (int, np.integer)) and frame_skip >= 1,
@@ -272,18 +273,22 @@ class MoreauJeanTask:
                     self.dt, self._constants, state.obs)
         return state.obs
 
-    def reset_copy(self, state: BatchState, index: int, rng: np.random.Generator) -> None:
-        """Put copy ``index`` at a fresh start state drawn from ``rng``."""
-        q, u = self.initial_state(rng)
-        state.q[index] = q
-        state.u[index] = u
-        state.tau[index] = 0.0
-        state.brake[index] = 0.0
-        state.impulses[index] = 0.0  # the first step starts its solver cold
-        state.elapsed_steps[index] = 0
-        state.effort[index] = 0.0
-        state.terminated[index] = False
-        self.update_potential(state, index)
+    def reset_copies(self, state: BatchState, indices: Any,
+                     rngs: Sequence[np.random.Generator]) -> None:  # fmt: skip
+        """Put the copies ``indices`` ((K,) int) at fresh start states, the k-th drawn from
+        ``rngs[k]``, and write their observations into ``state.obs``.
+
+        Torques, brakes and impulses (the first step starts its solver cold), elapsed steps,
+        effort and the termination flag restart from zero; Phi from the start state.
+        """
+        indices = np.asarray(indices, np.int64)
+        for index, rng in zip(indices.tolist(), rngs, strict=True):
+            q, u = self.initial_state(rng)
+            state.q[index] = q
+            state.u[index] = u
+        if self._kernels is None:
+            self._kernels = _compiled(self)
+        self._kernels[3](indices, state.buffer, state.obs, self._task_array)
 
     def update_potential(self, state: BatchState, index: int) -> None:
         """Phi of copy ``index`` after its state was set from outside the step."""
@@ -430,11 +435,11 @@ class MoreauJeanEnv(gym.Env[Any, Any]):
               ) -> tuple[Any, dict[str, Any]]:  # fmt: skip
         """Start a new episode (start state drawn from ``self.np_random``)."""
         super().reset(seed=seed)
-        self.task.reset_copy(self.state, 0, self.np_random)
+        self.task.reset_copies(self.state, _FIRST_COPY, (self.np_random,))
         self._has_reset = True
         if self.render_mode == "human":
             self.render()
-        return self.task.observe(self.state)[0].copy(), {}
+        return self.state.obs[0].copy(), {}
 
     def render(self) -> Any:
         """Draw the scene: an (H, W, 3) uint8 array in "rgb_array" mode, a window in "human"."""
@@ -525,10 +530,10 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
                     self._rngs[i] = seeding.np_random(seeds[i])[0]
         if seed is not None:
             self._np_random, self._np_random_seed = seeding.np_random(seeds[0])
-        for i in np.flatnonzero(mask):
-            self.task.reset_copy(self.state, int(i), self._rngs[i])
+        indices = np.flatnonzero(mask)
+        self.task.reset_copies(self.state, indices, [self._rngs[i] for i in indices])
         self._autoreset[mask] = False
-        return self.task.observe(self.state).copy(), {}
+        return self.state.obs.copy(), {}
 
     def step(self, actions: Any) -> tuple[Any, FloatArray, BoolArray, BoolArray, dict[str, Any]]:
         """Advance every copy by ``dt`` (copies that ended last step are reset instead)."""
@@ -544,10 +549,8 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
             truncated = np.zeros(self.num_envs, np.bool_)
         reward = reward.copy()
         resetting = np.flatnonzero(self._autoreset)
-        for i in resetting:
-            self.task.reset_copy(self.state, int(i), self._rngs[i])
         if resetting.size:
-            self.task.observe(self.state)
+            self.task.reset_copies(self.state, resetting, [self._rngs[i] for i in resetting])
             reward[resetting] = 0.0
             terminated[resetting] = False
             truncated[resetting] = False
@@ -562,7 +565,8 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         return self.state.obs.copy(), reward, terminated, truncated, infos
 
 
-_COMPILED: dict[tuple[Any, ...], tuple[Any, Any, Any]] = {}
+_COMPILED: dict[tuple[Any, ...], tuple[Any, Any, Any, Any]] = {}
+_FIRST_COPY = np.zeros(1, np.int64)
 SETTINGS_SIZE = 11
 """Entries of ``MoreauJeanTask._task_array`` before the model's parameter record."""
 ADVANCE_OK, ADVANCE_ACTION_NOT_FINITE, ADVANCE_STATE_NOT_FINITE = 0, 1, 2
@@ -611,12 +615,12 @@ def _info_builder(keys: tuple[str, ...]) -> Any:
 _INFO_BUILDERS: dict[tuple[str, ...], Any] = {}
 
 
-def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any]:
+def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     """The batched kernels of ``task``: compiled once per task class, stepper kernel, parameter
     record type and state layout, per process.
 
-    Returns (advance, observe_all, distance_one). ``advance(levels, buffer, obs, task_array,
-    *workspace)`` decodes the actions, runs the physics substeps and then the rewards,
+    Returns (advance, observe_all, distance_one, restart). ``advance(levels, buffer, obs,
+    task_array, *workspace)`` decodes the actions, runs the physics substeps and then the rewards,
     observations and info of every copy in one compiled call (one dispatch from Python per
     env step), and returns an ``ADVANCE_*`` outcome. Its arguments are six arrays (each costs
     about 0.1 us to type per call, a tuple several): the state is one buffer carved inside,
@@ -708,7 +712,26 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any]:
             time_left = (horizon - elapsed[i]) * dt if horizon > 0 else 0.0
             observe_one(q[i], u[i], brake[i], time_left, c, obs[i])
 
-    _COMPILED[key] = (advance, observe_all, distance_one)
+    @njit
+    def restart(indices, buffer, obs, settings):  # noqa: ANN001
+        """Zero the episode state of the copies ``indices`` (q, u already set), then their
+        Phi and observation (see ``MoreauJeanTask.reset_copies``).
+        """
+        (q, u, tau, brake, impulses, _, _, elapsed, effort, potential, terminated,
+         _) = carve_state(buffer, obs.shape[0])
+        c = settings[constants_start:]
+        horizon, dt, shaping_weight = settings[3], settings[2], settings[6]
+        for i in indices:
+            tau[i, :] = 0.0
+            brake[i, :] = 0.0
+            impulses[i, :] = 0.0
+            elapsed[i] = 0.0
+            effort[i] = 0.0
+            terminated[i] = 0.0
+            potential[i] = -shaping_weight * distance_one(q[i], u[i], c)
+            observe_one(q[i], u[i], brake[i], horizon * dt, c, obs[i])
+
+    _COMPILED[key] = (advance, observe_all, distance_one, restart)
     return _COMPILED[key]
 
 
