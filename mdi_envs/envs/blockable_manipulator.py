@@ -44,7 +44,6 @@ class BlockableManipulatorTask(MoreauJeanTask):
         # motor torque [N m] and brake bound (see the env's Action Space)
         self.actions = TorqueBrakeActions(action_mode, 1, True, self.max_torque,
                                           self.max_brake_torque)  # fmt: skip
-        self.action_mode = action_mode
         self.single_action_space = self.actions.space()
         high = np.array([1, 1, 1, 1, np.inf, np.inf, 1], np.float32)  # see observe_one
         low = -high
