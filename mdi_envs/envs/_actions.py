@@ -4,16 +4,18 @@ Normalised torques in [-1, 1] are scaled by the scene's bound; the brake is eith
 from a Box component ("box"), a Discrete choice ("hybrid") or a continuous Tresca bound
 ("brake_force"). Out-of-range values are clipped; NaN/inf or wrong shapes raise ValueError.
 
-Decoding is split in two so that an env step costs one compiled call: ``TorqueBrakeActions
-.levels`` checks the action's type and shape in Python and returns the normalised levels
-(N, width) (the caller's array itself when it is already a float array of the right shape);
-``decode_levels``, compiled and called first inside the env's step kernel, checks them for
-NaN/inf and writes the torques and brake bounds.
+Decoding is split in two so that an env step costs one compiled call: a float32/float64 array
+whose last axis is ``array_tail`` goes to the env's step kernel as it is (which checks its size
+and rank), anything else through ``TorqueBrakeActions.levels``, which checks the action's type
+and shape in Python and returns the normalised levels (N, width); ``decode_levels``, compiled
+and called first inside the kernel, checks them for NaN/inf and writes the torques and brake
+bounds.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -72,6 +74,14 @@ class TorqueBrakeActions:
     def width(self) -> int:
         """Entries of one copy's normalised levels: the torques, then the brake (if any)."""
         return self.num_torques + (1 if self.has_brake else 0)
+
+    @cached_property
+    def array_tail(self) -> tuple[int, ...] | None:
+        """``(width,)``: an action array with this last axis holds the levels themselves.
+
+        None in "hybrid" mode, whose actions are tuples.
+        """
+        return None if self.mode == "hybrid" else (self.width,)
 
     @property
     def rule(self) -> int:

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -126,7 +126,6 @@ class MoreauJeanTask:
         locate_impacts: bool = False,
     ) -> None:
         self._task_array_cache: FloatArray | None = None
-        self._kernels: tuple[Any, Any, Any, Any] | None = None
         self._info_keys = BASE_INFO_KEYS + self.INFO_KEYS
         self._info_of = _info_builder(self._info_keys)
         _require(isinstance(frame_skip, (int, np.integer)) and frame_skip >= 1,
@@ -158,18 +157,27 @@ class MoreauJeanTask:
         self.goal_weight = require_nonnegative("goal_weight", goal_weight)
         self.effort_weight = require_nonnegative("effort_weight", effort_weight)
         self.reset_noise_scale = require_nonnegative("reset_noise_scale", reset_noise_scale)
+        self._take_kernels()
+
+    def _take_kernels(self) -> None:
+        """Look up (or build) the compiled kernels of this task (see ``_compiled``)."""
+        self._kernels = _compiled(self)
+        self._advance_kernel = self._kernels[0]
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle without the compiled kernels and the info builder (rebuilt when unpickled)."""
-        return {**self.__dict__, "_kernels": None, "_info_of": None}
+        return {key: value for key, value in self.__dict__.items()
+                if key not in ("_kernels", "_advance_kernel", "_info_of")}  # fmt: skip
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self._info_of = _info_builder(self._info_keys)
+        self._take_kernels()
 
     @property
     def _task_array(self) -> FloatArray:
-        """Everything the compiled ``advance`` reads of the task, in one float64 array.
+        """Everything the compiled ``advance`` reads of the task, in one float64 array (copied
+        to the end of every ``BatchState`` buffer).
 
         (time_step, frame_skip, dt, horizon steps, effort_weight, goal_weight, shaping_weight,
         shaping_discount, action rule, max_torque, max_brake_torque), then the model's
@@ -240,22 +248,35 @@ class MoreauJeanTask:
         ``state.brake``, step the physics of every copy, then the rewards, observations and
         info columns (all written into ``state``), in one compiled call.
 
+        A float32/float64 array whose last axis is the action width goes to the compiled call
+        as it is (its size and rank are checked there); anything else through
+        ``actions.levels``.
+
         Raises:
             ValueError: a wrong shape or NaN/inf in ``actions`` (``state`` is left unchanged).
             RuntimeError: the physics produced a non-finite state.
         """
-        levels = self.actions.levels(actions, state.num_copies)
-        if self._kernels is None:
-            self._kernels = _compiled(self)
-        outcome = self._kernels[0](levels, state.buffer, state.obs, self._task_array,
-                                   *self.stepper.compiled_step_batch[2])  # fmt: skip
+        if (type(actions) is np.ndarray and actions.dtype.char in "fd"
+                and actions.shape[-1:] == self.actions.array_tail):
+            levels = actions
+        else:
+            levels = self.actions.levels(actions, state.num_copies)
+        outcome = self._advance_kernel(levels, state.buffer)
+        if outcome != ADVANCE_OK:
+            self._raise_for(outcome, state, actions, levels)
+
+    def _raise_for(self, outcome: int, state: BatchState, actions: Any, levels: Any) -> None:
+        """The error of a failed ``advance`` (``outcome`` an ``ADVANCE_*`` code)."""
+        if outcome == ADVANCE_ACTION_SHAPE:
+            self.actions.levels(actions, state.num_copies)  # raises, naming the shape
+            raise ValueError(f"action must have shape {self.single_action_space.shape} per "
+                             f"copy, got {np.shape(actions)}")  # fmt: skip
         if outcome == ADVANCE_ACTION_NOT_FINITE:
             raise ValueError(f"action contains NaN or inf entries: {np.asarray(levels).tolist()}")
-        if outcome == ADVANCE_STATE_NOT_FINITE:
-            raise RuntimeError(
-                "the physics step produced a non-finite state (solver status codes "
-                f"{state.physics[:, INFO_STATUS].tolist()}); please report this with the seed"
-            )
+        raise RuntimeError(
+            "the physics step produced a non-finite state (solver status codes "
+            f"{state.physics[:, INFO_STATUS].tolist()}); please report this with the seed"
+        )
 
     def info_arrays(self, state: BatchState) -> dict[str, Any]:
         """The last step's info as name -> (N,) array (bool and int entries typed)."""
@@ -268,7 +289,7 @@ class MoreauJeanTask:
 
     def observe(self, state: BatchState) -> Any:
         """Recompute every copy's observation into ``state.obs`` and return it."""
-        observe_all = _compiled(self)[1]
+        observe_all = self._kernels[1]
         observe_all(state.q, state.u, state.brake, state.elapsed_steps, self.num_horizon_steps,
                     self.dt, self._constants, state.obs)
         return state.obs
@@ -286,14 +307,11 @@ class MoreauJeanTask:
             q, u = self.initial_state(rng)
             state.q[index] = q
             state.u[index] = u
-        if self._kernels is None:
-            self._kernels = _compiled(self)
-        self._kernels[3](indices, state.buffer, state.obs, self._task_array)
+        self._kernels[3](indices, state.buffer)
 
     def update_potential(self, state: BatchState, index: int) -> None:
         """Phi of copy ``index`` after its state was set from outside the step."""
-        distance_one = _compiled(self)[2]
-        distance = distance_one(state.q[index], state.u[index], self._constants)
+        distance = self._kernels[2](state.q[index], state.u[index], self._constants)
         state.potential[index] = -self.shaping_weight * distance
 
     def noise(self, rng: np.random.Generator, size: int) -> FloatArray:
@@ -302,7 +320,7 @@ class MoreauJeanTask:
 
 
 def state_fields(task: MoreauJeanTask) -> tuple[tuple[str, int | None], ...]:
-    """(name, width) of the ``BatchState`` arrays inside its buffer, in order.
+    """(name, width) of the per-copy ``BatchState`` arrays inside its buffer, in order.
 
     Width w makes an (N, w) array, None an (N,) array (one number per copy).
     """
@@ -314,12 +332,44 @@ def state_fields(task: MoreauJeanTask) -> tuple[tuple[str, int | None], ...]:
             ("terminated", None), ("reward", None))  # fmt: skip
 
 
+class StateLayout(NamedTuple):
+    """The layout of a ``BatchState`` buffer (see ``BatchState``), hashable.
+
+    Attributes:
+        fields: the per-copy arrays (``state_fields``).
+        workspace_floats, workspace_ints: sizes of the stepper's scratch (``make_workspace``).
+        num_observations: entries of one copy's float32 observation.
+    """
+
+    fields: tuple[tuple[str, int | None], ...]
+    workspace_floats: int
+    workspace_ints: int
+    num_observations: int
+
+    @classmethod
+    def of(cls, task: MoreauJeanTask) -> StateLayout:
+        """The layout of ``task``'s states."""
+        floats, ints = task.stepper.compiled_step_batch[2]
+        return cls(state_fields(task), floats.size, ints.size, task.NUM_OBSERVATIONS)
+
+    def size(self, num_copies: int, num_settings: int) -> int:
+        """float64 entries of the buffer of ``num_copies`` copies and ``num_settings`` settings."""
+        per_copy = sum(1 if width is None else width for _, width in self.fields)
+        observation_slots = (num_copies * self.num_observations + 1) // 2
+        return (1 + self.workspace_floats + self.workspace_ints + num_copies * per_copy
+                + observation_slots + num_settings)  # fmt: skip
+
+
 class BatchState:
     """The mutable state of N copies: physics arrays advanced in place, episode bookkeeping.
 
-    All arrays but ``obs`` are C-contiguous float64 views into one flat ``buffer``, laid out
-    by ``state_fields`` (array after array), so that the compiled step takes the whole state
-    as one argument. Assign into them (``state.q[i] = ...``), never rebind them.
+    Everything the compiled step reads and writes lives in one flat float64 ``buffer``, so that
+    an env step passes it as one argument: N, the stepper's scratch (its int part read through
+    an int64 view), the per-copy arrays of ``state_fields`` (C-contiguous float64, array after
+    array), the float32 observations (a float32 view of ceil(N * NUM_OBSERVATIONS / 2) float64
+    entries) and last a copy of the task's settings (``MoreauJeanTask._task_array``). The same
+    generated function carves the views here (numpy) and inside the kernels (numba). Assign
+    into them (``state.q[i] = ...``), never rebind them.
 
     Attributes:
         q, u: (N, n) coordinates and velocities. tau: (N, m) last torques [N m].
@@ -344,25 +394,25 @@ class BatchState:
     potential: FloatArray
     terminated: FloatArray
     reward: FloatArray
+    obs: np.ndarray
 
     def __init__(self, task: MoreauJeanTask, num_copies: int) -> None:
         self.num_copies = num_copies
-        self._fields = state_fields(task)
-        per_copy = sum(1 if width is None else width for _, width in self._fields)
-        self.buffer = np.zeros(num_copies * per_copy)
-        self.obs = np.zeros((num_copies, task.NUM_OBSERVATIONS), np.float32)
+        self.layout = StateLayout.of(task)
+        settings = task._task_array
+        self.buffer = np.zeros(self.layout.size(num_copies, settings.size))
+        self.buffer[0] = num_copies
+        self.buffer[self.buffer.size - settings.size:] = settings
         self._take_views()
 
     def _take_views(self) -> None:
-        start = 0
-        for name, width in self._fields:
-            view = self.buffer[start:start + self.num_copies * (1 if width is None else width)]
-            setattr(self, name, view if width is None else view.reshape(self.num_copies, width))
-            start += view.size
+        names, carve, _ = _state_carver(self.layout)
+        for name, view in zip(names, carve(self.buffer), strict=True):
+            setattr(self, name, view)
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle the buffer, not its views (unpickled views would be copies)."""
-        return {key: self.__dict__[key] for key in ("num_copies", "_fields", "buffer", "obs")}
+        return {key: self.__dict__[key] for key in ("num_copies", "layout", "buffer")}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
@@ -569,27 +619,45 @@ _COMPILED: dict[tuple[Any, ...], tuple[Any, Any, Any, Any]] = {}
 _FIRST_COPY = np.zeros(1, np.int64)
 SETTINGS_SIZE = 11
 """Entries of ``MoreauJeanTask._task_array`` before the model's parameter record."""
-ADVANCE_OK, ADVANCE_ACTION_NOT_FINITE, ADVANCE_STATE_NOT_FINITE = 0, 1, 2
+ADVANCE_OK, ADVANCE_ACTION_NOT_FINITE, ADVANCE_STATE_NOT_FINITE, ADVANCE_ACTION_SHAPE = 0, 1, 2, 3
 """Outcomes of the compiled ``advance``."""
 
 
-def _make_state_carver(fields: tuple[tuple[str, int | None], ...]) -> Any:
-    """A compiled ``carve(buffer, N)``: the ``BatchState`` views of a flat buffer, in order.
+def _state_carver(layout: StateLayout) -> tuple[tuple[str, ...], Any, Any]:
+    """(names, carve, compiled carve): ``carve(buffer)`` returns the named views of a
+    ``BatchState`` buffer, in order, from numpy arrays; the compiled one (inlined) inside the
+    kernels.
 
-    Generated so that every width is a compile-time constant; the views are those
-    ``BatchState`` takes in Python.
+    One generated source serves both, so the kernels and ``BatchState`` read the same layout;
+    every width is a compile-time constant. Cached per layout.
     """
-    lines = ["def carve(buffer, N):"]
-    start = "0"
-    for name, width in fields:
-        end = f"{start} + N * {1 if width is None else width}"
-        shape = "" if width is None else f".reshape((N, {width}))"
-        lines.append(f"    {name} = buffer[{start}:{end}]{shape}")
-        start = end
-    lines.append(f"    return ({', '.join(name for name, _ in fields)},)")
-    namespace: dict[str, Any] = {}
-    exec("\n".join(lines), namespace)  # noqa: S102 - generated from the fields' widths
-    return njit(inline="always")(namespace["carve"])
+    if layout not in _CARVERS:
+        floats, ints = layout.workspace_floats, layout.workspace_ints
+        lines = ["def carve(buffer):",
+                 "    N = int(buffer[0])",
+                 f"    workspace_floats = buffer[1:{1 + floats}]",
+                 f"    workspace_ints = buffer[{1 + floats}:{1 + floats + ints}].view(np.int64)"]
+        start = str(1 + floats + ints)
+        for name, width in layout.fields:
+            end = f"{start} + N * {1 if width is None else width}"
+            shape = "" if width is None else f".reshape((N, {width}))"
+            lines.append(f"    {name} = buffer[{start}:{end}]{shape}")
+            start = end
+        k = layout.num_observations
+        lines += [f"    obs = buffer[{start}:{start} + (N * {k} + 1) // 2].view(np.float32)"
+                  f"[:N * {k}].reshape((N, {k}))",
+                  f"    settings = buffer[{start} + (N * {k} + 1) // 2:]"]
+        names = ("workspace_floats", "workspace_ints", *(name for name, _ in layout.fields),
+                 "obs", "settings")
+        lines.append(f"    return ({', '.join(names)},)")
+        namespace: dict[str, Any] = {"np": np}
+        exec("\n".join(lines), namespace)  # noqa: S102 - generated from the layout's widths
+        carve = namespace["carve"]
+        _CARVERS[layout] = (names, carve, njit(inline="always")(carve))
+    return _CARVERS[layout]
+
+
+_CARVERS: dict[StateLayout, tuple[tuple[str, ...], Any, Any]] = {}
 
 
 def _info_builder(keys: tuple[str, ...]) -> Any:
@@ -619,16 +687,16 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     """The batched kernels of ``task``: compiled once per task class, stepper kernel, parameter
     record type and state layout, per process.
 
-    Returns (advance, observe_all, distance_one, restart). ``advance(levels, buffer, obs,
-    task_array, *workspace)`` decodes the actions, runs the physics substeps and then the rewards,
-    observations and info of every copy in one compiled call (one dispatch from Python per
-    env step), and returns an ``ADVANCE_*`` outcome. Its arguments are six arrays (each costs
-    about 0.1 us to type per call, a tuple several): the state is one buffer carved inside,
-    the parameter record is rebuilt inside from the task array.
+    Returns (advance, observe_all, distance_one, restart). ``advance(levels, buffer)`` checks
+    the levels' size and rank, decodes the actions, runs the physics substeps and then the
+    rewards, observations and info of every copy in one compiled call (one dispatch from Python
+    per env step), and returns an ``ADVANCE_*`` outcome. Its arguments are two arrays (each
+    costs about 0.1 us to type per call, a tuple several): everything else is carved from the
+    ``BatchState`` buffer inside, the parameter record rebuilt from its settings.
     """
     step_batch, record = task.stepper.compiled_step_batch[:2]
-    fields = state_fields(task)
-    key = (type(task), step_batch, type(record), fields)
+    layout = StateLayout.of(task)
+    key = (type(task), step_batch, type(record), layout)
     if key in _COMPILED:
         return _COMPILED[key]
     record_entries = ", ".join(f"settings[{SETTINGS_SIZE + i}]" for i in range(len(record)))
@@ -636,9 +704,10 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     exec(f"def read_record(settings):\n    return Record({record_entries})",  # noqa: S102
          namespace)  # fmt: skip
     read_record = njit(inline="always")(namespace["read_record"])
-    carve_state = _make_state_carver(fields)
+    carve_state = _state_carver(layout)[2]
     constants_start = SETTINGS_SIZE + len(record)
     num_torques = task.MODEL.NUM_INPUTS
+    width = num_torques + task.MODEL.NUM_BRAKES  # of one copy's levels
     # inlined into ``evaluate``: no call per copy, and one copy's array views stay local
     observe_one = njit(inline="always")(task.observe_one)
     distance_one = njit(inline="always")(task.distance_one)
@@ -692,14 +761,16 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
         return finite
 
     @njit
-    def advance(levels, buffer, obs, settings, *workspace):  # noqa: ANN001
-        (q, u, tau, brake, impulses, physics, info, elapsed, effort, potential, terminated,
-         reward) = carve_state(buffer, obs.shape[0])
+    def advance(levels, buffer):  # noqa: ANN001
+        (workspace_floats, workspace_ints, q, u, tau, brake, impulses, physics, info, elapsed,
+         effort, potential, terminated, reward, obs, settings) = carve_state(buffer)
+        if levels.ndim > 2 or levels.size != width * q.shape[0]:
+            return ADVANCE_ACTION_SHAPE
         if not decode_levels(levels, num_torques, int(settings[8]), settings[9], settings[10],
                              tau, brake):  # fmt: skip
             return ADVANCE_ACTION_NOT_FINITE
         step_batch(q, u, tau, brake, settings[0], read_record(settings), int(settings[1]),
-                   impulses, physics, workspace)
+                   impulses, physics, (workspace_floats, workspace_ints))
         finite = evaluate(q, u, tau, brake, impulses, physics, settings[constants_start:],
                           settings[2], int(settings[3]), settings[4], settings[5], settings[6],
                           settings[7], elapsed, effort, potential, terminated, reward, obs,
@@ -713,12 +784,12 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
             observe_one(q[i], u[i], brake[i], time_left, c, obs[i])
 
     @njit
-    def restart(indices, buffer, obs, settings):  # noqa: ANN001
+    def restart(indices, buffer):  # noqa: ANN001
         """Zero the episode state of the copies ``indices`` (q, u already set), then their
         Phi and observation (see ``MoreauJeanTask.reset_copies``).
         """
-        (q, u, tau, brake, impulses, _, _, elapsed, effort, potential, terminated,
-         _) = carve_state(buffer, obs.shape[0])
+        (_, _, q, u, tau, brake, impulses, _, _, elapsed, effort, potential, terminated, _, obs,
+         settings) = carve_state(buffer)
         c = settings[constants_start:]
         horizon, dt, shaping_weight = settings[3], settings[2], settings[6]
         for i in indices:

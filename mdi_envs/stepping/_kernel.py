@@ -464,7 +464,7 @@ def make_step_kernels(
 
     step_once = located_advance if locate_impacts else advance
 
-    @njit
+    @njit(inline="always")
     def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
         """One step (arguments as ``advance``; ws = ``make_workspace(model)``)."""
         step_once(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws[0], ws[1])

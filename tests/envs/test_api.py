@@ -175,6 +175,22 @@ def test_wrong_shape_action_is_rejected(env_id: str) -> None:
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("num_envs, copies", [(1, (2,)), (1, (1, 1)), (3, (2,)), (3, (4,))])
+def test_action_of_the_wrong_count_or_rank_is_rejected(
+    env_id: str, num_envs: int, copies: tuple[int, ...]
+) -> None:
+    """The wrong number of copies (or rank) with the right last axis is rejected unchanged.
+
+    Such an array goes to the compiled step as it is: the step raises, naming the shape.
+    """
+    envs = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point")
+    envs.reset(seed=0)
+    before = envs.unwrapped.state.buffer.copy()
+    with pytest.raises(ValueError, match="shape"):
+        envs.step(np.zeros((*copies, envs.single_action_space.shape[0]), np.float32))
+    np.testing.assert_array_equal(envs.unwrapped.state.buffer, before)
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
 def test_out_of_range_action_is_clipped(env_id: str) -> None:
     """An action of 5 everywhere does what an action of 1 does."""
     results = []
