@@ -83,8 +83,8 @@ class MoreauJeanTask:
     Subclasses set ``MODEL``, ``NUM_OBSERVATIONS`` and ``OBJECTIVE_OPTIONS``, the action coding
     ``actions`` with ``single_action_space = actions.space()``, the observation space, and
     implement the compiled ``observe_one``, ``distance_one`` and ``success_one`` with their
-    ``constants``, plus ``initial_state`` and ``info_one`` with ``INFO_KEYS``. Arrays are
-    float64 of shape (N, ...), observations float32.
+    ``constants``, plus ``nominal_start`` with ``START_NOISE_ENTRIES`` and ``info_one`` with
+    ``INFO_KEYS``. Arrays are float64 of shape (N, ...), observations float32.
 
     Args:
         parameters: the model's parameter dataclass (default: its defaults).
@@ -222,8 +222,12 @@ class MoreauJeanTask:
         """The scene constants ``c`` read by the compiled functions, float64 (any length)."""
         raise NotImplementedError
 
-    def initial_state(self, rng: np.random.Generator) -> tuple[FloatArray, FloatArray]:
-        """One copy's start (q (n,), u (n,)), drawn from ``rng`` only."""
+    START_NOISE_ENTRIES: ClassVar[tuple[int, ...]]
+    """Entries of the stacked start state (q, u) (2n,) that get the reset noise, in the order
+    of their draws."""
+
+    def nominal_start(self) -> FloatArray:
+        """The start state (q, u) stacked, (2n,), before the reset noise."""
         raise NotImplementedError
 
     INFO_KEYS: ClassVar[tuple[str, ...]] = ()
@@ -299,24 +303,31 @@ class MoreauJeanTask:
         """Put the copies ``indices`` ((K,) int) at fresh start states, the k-th drawn from
         ``rngs[k]``, and write their observations into ``state.obs``.
 
-        Torques, brakes and impulses (the first step starts its solver cold), elapsed steps,
-        effort and the termination flag restart from zero; Phi from the start state.
+        A start state is ``nominal_start()`` plus, on ``START_NOISE_ENTRIES``, the draws of
+        ``rng.uniform(-reset_noise_scale, reset_noise_scale, len(START_NOISE_ENTRIES))``
+        (computed here for all copies at once from one ``rng.random`` call per copy, with
+        Generator.uniform's arithmetic, so the values are the same). Torques, brakes and
+        impulses (the first step starts its solver cold), elapsed steps, effort and the
+        termination flag restart from zero; Phi from the start state.
         """
         indices = np.asarray(indices, np.int64)
-        for index, rng in zip(indices.tolist(), rngs, strict=True):
-            q, u = self.initial_state(rng)
-            state.q[index] = q
-            state.u[index] = u
+        entries = list(self.START_NOISE_ENTRIES)
+        if len(rngs) != indices.size:
+            raise ValueError(f"{len(rngs)} generators for {indices.size} copies")
+        draws = np.array([rng.random(len(entries)) for rng in rngs]).reshape(
+            indices.size, len(entries))
+        low, high = -self.reset_noise_scale, self.reset_noise_scale
+        starts = np.tile(self.nominal_start(), (indices.size, 1))
+        starts[:, entries] += low + (high - low) * draws
+        n = self.MODEL.NUM_DOFS
+        state.q[indices] = starts[:, :n]
+        state.u[indices] = starts[:, n:]
         self._kernels[3](indices, state.buffer)
 
     def update_potential(self, state: BatchState, index: int) -> None:
         """Phi of copy ``index`` after its state was set from outside the step."""
         distance = self._kernels[2](state.q[index], state.u[index], self._constants)
         state.potential[index] = -self.shaping_weight * distance
-
-    def noise(self, rng: np.random.Generator, size: int) -> FloatArray:
-        """Uniform start noise in [-reset_noise_scale, reset_noise_scale], (size,)."""
-        return rng.uniform(-self.reset_noise_scale, self.reset_noise_scale, size)
 
 
 def state_fields(task: MoreauJeanTask) -> tuple[tuple[str, int | None], ...]:

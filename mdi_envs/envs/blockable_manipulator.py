@@ -50,10 +50,11 @@ class BlockableManipulatorTask(MoreauJeanTask):
         low[-1] = 0.0
         self.single_observation_space = spaces.Box(low, high, dtype=np.float32)
 
-    def initial_state(self, rng: np.random.Generator) -> tuple[FloatArray, FloatArray]:
-        """Rest at alpha = beta = 0, each coordinate and speed perturbed by the reset noise."""
-        q = np.array(MANIPULATOR_TASK.initial_q) + self.noise(rng, 2)
-        return q, self.noise(rng, 2)
+    START_NOISE_ENTRIES = (0, 1, 2, 3)  # alpha, beta, alpha', beta'
+
+    def nominal_start(self) -> FloatArray:
+        """Rest at alpha = beta = 0."""
+        return np.array([*MANIPULATOR_TASK.initial_q, 0.0, 0.0])
 
     def constants(self) -> FloatArray:
         """(goal alpha, goal beta, angle tol, speed tol, velocity weight, max brake torque)."""

@@ -60,13 +60,11 @@ class DiffDriveRobotTask(MoreauJeanTask):
         high[-1] = max(self.final_time, 1.0)  # time left; always 0 for "time"
         self.single_observation_space = spaces.Box(low, high, dtype=np.float32)
 
-    def initial_state(self, rng: np.random.Generator) -> tuple[FloatArray, FloatArray]:
-        """Rest at the origin heading +x; pose and velocities plus the reset noise."""
-        q = np.zeros(5)
-        q[:3] = np.array(DIFF_DRIVE_TASK.initial_pose) + self.noise(rng, 3)
-        u = np.zeros(5)
-        u[:3] = self.noise(rng, 3)
-        return q, u
+    START_NOISE_ENTRIES = (0, 1, 2, 5, 6, 7)  # x, y, phi, then their rates
+
+    def nominal_start(self) -> FloatArray:
+        """Rest at the origin heading +x (wheel angles 0)."""
+        return np.array([*DIFF_DRIVE_TASK.initial_pose, 0.0, 0.0, *np.zeros(5)])
 
     def constants(self) -> FloatArray:
         """(goal x, y, phi, the four tolerances, the three distance weights)."""

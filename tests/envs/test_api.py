@@ -204,6 +204,20 @@ def test_out_of_range_action_is_clipped(env_id: str) -> None:
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
+def test_start_state_is_the_nominal_one_plus_uniform_noise(env_id: str) -> None:
+    """reset(seed=s) draws Generator(s).uniform(-scale, scale) onto the noisy entries only."""
+    scale = 0.05
+    env = make(env_id, reset_noise_scale=scale)
+    env.reset(seed=7)
+    task = env.unwrapped.task
+    entries = list(task.START_NOISE_ENTRIES)
+    expected = task.nominal_start()
+    expected[entries] += gym.utils.seeding.np_random(7)[0].uniform(-scale, scale, len(entries))
+    state = env.unwrapped.state
+    np.testing.assert_array_equal(np.concatenate([state.q[0], state.u[0]]), expected)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
 def test_step_before_reset_is_an_error(env_id: str) -> None:
     env = make(env_id).unwrapped
     with pytest.raises(gym.error.ResetNeeded):
