@@ -105,7 +105,7 @@ FULL = EnvsConfig(
     copies=(1, 4, 16, 64, 256, 1024, 4096),
     action_samples=1024,
     step_plan=TimingPlan(budget_s=2.0, min_rounds=21, max_rounds=301, min_batch_s=5e-3),
-    vector_plan=TimingPlan(budget_s=0.6, min_rounds=9, max_rounds=61, min_batch_s=5e-3),
+    vector_plan=TimingPlan(budget_s=2.0, min_rounds=21, max_rounds=61, min_batch_s=5e-3),
 )
 QUICK = EnvsConfig(
     env_ids=("mdi_envs/BlockableManipulator-v0",),
