@@ -53,6 +53,7 @@ from benchmarks.timing import (
     TimingPlan,
     load_average,
     machine_info,
+    speed_probe,
     time_interleaved,
 )
 from mdi_envs.mechanics.compiled import compile_equations
@@ -576,6 +577,7 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
     R.plot_single_step(single, scenes, TARGETS_US, output / "engine_single_step.png")
     R.plot_shortcuts(shortcuts, output / "engine_shortcuts.png")
     record["machine"]["load_average_at_end"] = load_average()
+    record["machine"]["speed_probe_at_end"] = speed_probe()
     record["run_time_s"] = log.elapsed
     report.write_json(record, output / "engine.json")
     log(f"done in {log.elapsed:.0f} s; wrote engine.json and 3 plots to {output}")

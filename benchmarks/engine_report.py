@@ -8,7 +8,13 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import format_us, load_average_text, markdown_table, plt
+from benchmarks.report import (
+    format_us,
+    load_average_text,
+    machine_speed_text,
+    markdown_table,
+    plt,
+)
 
 MODEL_TITLES = {
     "ball": "bouncing ball",
@@ -207,7 +213,8 @@ def markdown_report(record: Mapping[str, Any]) -> str:
         f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
         f"numpy {versions.get('numpy')}, numba {versions.get('numba')}, mujoco "
         f"{versions.get('mujoco')}; total {record['run_time_s']:.0f} s"
-        f"{' (--quick)' if record['config']['quick'] else ''}; {load_text}.",
+        f"{' (--quick)' if record['config']['quick'] else ''}; {load_text}; "
+        f"{machine_speed_text(machine)}.",
     ]
     if record["notes"]:
         lines += ["", *(f"* {note}" for note in record["notes"])]

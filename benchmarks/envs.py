@@ -38,7 +38,14 @@ import gymnasium as gym
 import mdi_envs
 from benchmarks import envs_report as R
 from benchmarks import report
-from benchmarks.timing import Progress, TimingPlan, load_average, machine_info, time_interleaved
+from benchmarks.timing import (
+    Progress,
+    TimingPlan,
+    load_average,
+    machine_info,
+    speed_probe,
+    time_interleaved,
+)
 
 ACROBOT = "Acrobot-v1"
 MUJOCO_PEER = "InvertedDoublePendulum-v5"
@@ -493,6 +500,7 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
         R.plot_step(single, unavailable, TARGETS, output / "envs_step.png")
         R.plot_vector(vector, TARGETS, output / "envs_vector.png")
         record["machine"]["load_average_at_end"] = load_average()
+        record["machine"]["speed_probe_at_end"] = speed_probe()
         record["run_time_s"] = progress.elapsed
         report.write_json(record, output / "envs.json")
         log(f"done in {progress.elapsed:.0f} s; wrote envs.json, envs_step.png and "

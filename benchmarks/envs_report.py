@@ -8,7 +8,13 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import format_ratio, load_average_text, markdown_table, plt
+from benchmarks.report import (
+    format_ratio,
+    load_average_text,
+    machine_speed_text,
+    markdown_table,
+    plt,
+)
 
 SHORT_NAMES = {
     "mdi_envs/BlockableManipulator-v0": "BlockableManipulator",
@@ -115,7 +121,8 @@ def markdown_report(record: Mapping[str, Any]) -> str:
         f"{pin_text}), Python {machine['python']}, numpy {versions.get('numpy')}, numba "
         f"{versions.get('numba')}, gymnasium {versions.get('gymnasium')}, mujoco "
         f"{versions.get('mujoco')}; total {record['run_time_s']:.0f} s"
-        f"{' (--quick)' if record['config']['quick'] else ''}; {load_text}.",
+        f"{' (--quick)' if record['config']['quick'] else ''}; {load_text}; "
+        f"{machine_speed_text(machine)}.",
     ]
     if record["notes"]:
         lines += ["", *(f"* {note}" for note in record["notes"])]

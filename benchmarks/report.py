@@ -99,6 +99,19 @@ def load_average_text(machine: Mapping[str, Any]) -> str:
             f"{'/'.join(f'{x:.2f}' for x in end)} at end")
 
 
+def machine_speed_text(machine: Mapping[str, Any]) -> str:
+    """The machine record's speed probes (``timing.speed_probe``) at start and end, as a phrase."""
+    parts = []
+    for when in ("start", "end"):
+        probe = machine.get(f"speed_probe_at_{when}")
+        if probe:
+            parts.append(f"{probe['fastest_us']:.2f} µs fastest, {probe['median_us']:.2f} µs "
+                         f"median, {probe['slow_fraction']:.0%} of batches slow (> 1.5× the "
+                         f"fastest) at {when}")
+    return ("machine speed probe (a compiled no-op called from Python): " + "; ".join(parts)
+            if parts else "no machine speed probe")
+
+
 def markdown_table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
     """A GitHub Markdown table."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
