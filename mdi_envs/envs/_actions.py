@@ -4,12 +4,12 @@ Normalised torques in [-1, 1] are scaled by the scene's bound; the brake is eith
 from a Box component ("box"), a Discrete choice ("hybrid") or a continuous Tresca bound
 ("brake_force"). Out-of-range values are clipped; NaN/inf or wrong shapes raise ValueError.
 
-Decoding is split in two so that an env step costs one compiled call: a float32/float64 array
-whose last axis is ``array_tail`` goes to the env's step kernel as it is (which checks its size
-and rank), anything else through ``TorqueBrakeActions.levels``, which checks the action's type
-and shape in Python and returns the normalised levels (N, width); ``decode_levels``, compiled
-and called first inside the kernel, checks them for NaN/inf and writes the torques and brake
-bounds.
+Decoding is split in two so that an env step costs one compiled call: an array of a dtype in
+``ARRAY_DTYPE_CHARS`` whose last axis is ``array_tail`` goes to the env's step kernel as it is
+(which checks its size and rank), anything else through ``TorqueBrakeActions.levels``, which
+checks the action's type and shape in Python and returns the normalised levels (N, width);
+``decode_levels``, compiled and called first inside the kernel, checks them for NaN/inf and
+writes the torques and brake bounds.
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ from numba import njit
 from mdi_envs._types import FloatArray
 
 ACTION_MODES = ("box", "hybrid", "brake_force")
-_FAST_DTYPE_CHARS = "fd"  # float32, float64: passed to the compiled decoding as they are
+ARRAY_DTYPE_CHARS = "fd"
+"""dtype characters (float32, float64) of action arrays the env kernel takes as they are."""
 RULE_NO_BRAKE, RULE_BOX, RULE_BRAKE_FORCE, RULE_HYBRID = 0, 1, 2, 3
 """How ``decode_levels`` reads the brake level (see ``TorqueBrakeActions.rule``)."""
 
@@ -99,10 +100,9 @@ class TorqueBrakeActions:
         return spaces.Box(-1.0, 1.0, (self.width,), np.float32)
 
     def levels(self, actions: Any, num_copies: int) -> np.ndarray:
-        """A batch of actions as normalised levels, (num_copies, width) or (width,) for one copy.
+        """A batch of actions as float64 normalised levels, (num_copies, width).
 
-        A float32/float64 array of that shape is returned as it is (no copy); anything else
-        is converted to float64. NaN/inf are left for ``decode_levels`` to find.
+        A flat action is accepted for one copy. NaN/inf are left for ``decode_levels`` to find.
 
         Raises:
             ValueError: wrong shape, a non-numeric action, or a hybrid brake choice other
@@ -119,10 +119,6 @@ class TorqueBrakeActions:
                 actions[1], (num_copies, self.num_torques), "torque action")
             levels[:, self.num_torques] = choice
             return levels
-        if (type(actions) is np.ndarray and actions.dtype.char in _FAST_DTYPE_CHARS
-                and actions.size == num_copies * self.width and actions.ndim <= 2
-                and actions.shape[-1] == self.width):
-            return actions
         return _batch_array(actions, (num_copies, self.width), "action")
 
 
@@ -156,4 +152,4 @@ def decode_levels(levels: Any, num_torques: int, rule: int, max_torque: float,
     return True
 
 
-__all__ = ["ACTION_MODES", "TorqueBrakeActions", "decode_levels"]
+__all__ = ["ACTION_MODES", "ARRAY_DTYPE_CHARS", "TorqueBrakeActions", "decode_levels"]

@@ -36,7 +36,7 @@ from gymnasium.vector.utils import batch_space
 from numba import njit
 
 from mdi_envs._types import BoolArray, FloatArray
-from mdi_envs.envs._actions import TorqueBrakeActions, decode_levels
+from mdi_envs.envs._actions import ARRAY_DTYPE_CHARS, TorqueBrakeActions, decode_levels
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.mechanics.parameters import require_nonnegative, require_positive
 from mdi_envs.stepping._kernel import (
@@ -260,7 +260,7 @@ class MoreauJeanTask:
             ValueError: a wrong shape or NaN/inf in ``actions`` (``state`` is left unchanged).
             RuntimeError: the physics produced a non-finite state.
         """
-        if (type(actions) is np.ndarray and actions.dtype.char in "fd"
+        if (type(actions) is np.ndarray and actions.dtype.char in ARRAY_DTYPE_CHARS
                 and actions.shape[-1:] == self.actions.array_tail):
             levels = actions
         else:

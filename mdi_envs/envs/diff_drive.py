@@ -64,7 +64,7 @@ class DiffDriveRobotTask(MoreauJeanTask):
 
     def nominal_start(self) -> FloatArray:
         """Rest at the origin heading +x (wheel angles 0)."""
-        return np.array([*DIFF_DRIVE_TASK.initial_pose, 0.0, 0.0, *np.zeros(5)])
+        return np.concatenate([DIFF_DRIVE_TASK.initial_pose, np.zeros(7)])
 
     def constants(self) -> FloatArray:
         """(goal x, y, phi, the four tolerances, the three distance weights)."""
