@@ -201,13 +201,19 @@ def compile_steppers(cases: list[ModelCase], log: Progress, notes: list[str]
     return kept, steppers, records
 
 
+IN_PLACE_STEPS_PER_CALL = 200
+"""``InPlaceStepper.step`` calls per timed call (then the state goes back to the scene's)."""
+
+
 def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
     """``InPlaceStepper.step`` at the scene: the public fastest single step from Python.
 
-    One compiled call on a flat buffer. The state advances in place, so every 200th call first
-    puts it back at the scene's; the timing includes that reset and the Python counter deciding
-    it (one increment and comparison per call). The in-place kernel is compiled here, by one
-    step: a compilation inside the timer's warm-up call would make it time single calls.
+    One compiled call on a flat buffer. The returned callable makes ``IN_PLACE_STEPS_PER_CALL``
+    calls of ``step()`` in a Python ``for`` loop, as a user's rollout would, and then puts the
+    state back at the scene's (the state advances in place); its time is divided by that count,
+    so each step carries its share of the loop and of the reset. The in-place kernel is
+    compiled here, by one step: a compilation inside the timer's warm-up call would make it
+    time single calls.
     """
     q, u, tau, brake = arrays
     stepper = st.in_place(q, u)
@@ -217,16 +223,14 @@ def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
     stepper.step()
     stepper.q[:] = q
     stepper.u[:] = u
-    calls = [0]
     step = stepper.step
+    steps = range(IN_PLACE_STEPS_PER_CALL)
 
     def call() -> None:
-        calls[0] += 1
-        if calls[0] == 200:
-            calls[0] = 0
-            stepper.q[:] = q
-            stepper.u[:] = u
-        step()
+        for _ in steps:
+            step()
+        stepper.q[:] = q
+        stepper.u[:] = u
 
     return call
 
@@ -251,7 +255,9 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
     rows = []
     for key, value in timed.items():
         model, scene, entry = key.split("|")
-        rows.append({"model": model, "scene": scene, "entry": entry, **value.summary()})
+        steps = IN_PLACE_STEPS_PER_CALL if entry == "in_place" else 1
+        rows.append({"model": model, "scene": scene, "entry": entry,
+                     **value.summary(operations_per_call=steps)})
     for case in cases:
         cells = [f"{r['scene']} {R.format_us_fine(r['median_s'])}" for r in rows
                  if r["model"] == case.label and r["entry"] == "step"]

@@ -14,7 +14,7 @@ on stdout. Parts:
 2. single env: ``env.step`` of every registered ``mdi_envs.ENV_IDS`` and of the peers
    (Gymnasium's ``Acrobot-v1``, MuJoCo's ``InvertedDoublePendulum-v5``) through ``gym.make``
    (default wrappers) and unwrapped, interleaved, with pre-sampled actions and a reset whenever
-   an episode ends;
+   an episode ends, ``STEPS_PER_CALL`` steps per timed call in a plain ``for`` loop;
 3. vector env: env-steps/s of ``gym.make_vec(id, num_envs=N,
    vectorization_mode="vector_entry_point")`` for each N, interleaved per N with Acrobot-v1 in
    Gymnasium's ``"sync"`` mode (N <= 256), and physics steps/s = env-steps/s x frame_skip.
@@ -26,6 +26,7 @@ used (no kernel of ``mdi_envs`` is parallel).
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -71,6 +72,7 @@ UNITS = {
     "frame_skip": "physics steps per env step",
     "num_envs": "copies in one vector env",
     "rounds, number": "timed samples, calls per sample",
+    "steps_per_call": "env.step calls per call of a single-env loop (times are per step)",
 }
 
 
@@ -156,40 +158,54 @@ def _sample_actions(space: gym.Space, count: int, seed: int) -> list[Any]:
     return [space.sample() for _ in range(count)]
 
 
+STEPS_PER_CALL = 64
+"""``env.step`` calls per timed call of a ``StepLoop``."""
+
+
 class StepLoop:
-    """One ``env.step`` per call with the next pre-sampled action; reset when an episode ends.
+    """``steps_per_call`` calls of ``env.step`` per call, in a user's rollout loop.
+
+    A plain ``for`` loop over the next pre-sampled actions calling ``env.step`` and resetting
+    when an episode ends; each step carries its share of the loop and of the resets.
 
     Args:
         env: a reset single environment (wrapped or unwrapped).
         actions: the pre-sampled actions, cycled.
         max_steps: truncate after this many steps (for an unwrapped env without TimeLimit;
             None: rely on the env's own ``truncated``).
+        steps_per_call: steps per call.
 
     Attributes:
         steps, episodes: steps taken and episodes ended so far.
     """
 
-    def __init__(self, env: Any, actions: list[Any], max_steps: int | None = None) -> None:
+    def __init__(self, env: Any, actions: list[Any], max_steps: int | None = None,
+                 steps_per_call: int = STEPS_PER_CALL) -> None:
         self.env = env
-        self.actions = actions
         self.max_steps = max_steps
-        self.index = 0
+        self.steps_per_call = steps_per_call
+        cycle = len(actions) // math.gcd(len(actions), steps_per_call)
+        self.chunks = [[actions[(c * steps_per_call + j) % len(actions)]
+                        for j in range(steps_per_call)] for c in range(cycle)]
+        self.chunk = 0
         self.episode_steps = 0
         self.steps = 0
         self.episodes = 0
 
     def __call__(self) -> None:
-        """Step once (and reset if the episode ended)."""
-        index = self.index
-        _, _, terminated, truncated, _ = self.env.step(self.actions[index])
-        index += 1
-        self.index = 0 if index == len(self.actions) else index
-        self.steps += 1
-        self.episode_steps += 1
-        if terminated or truncated or self.episode_steps == self.max_steps:
-            self.env.reset()
-            self.episodes += 1
-            self.episode_steps = 0
+        """Step ``steps_per_call`` times (and reset whenever an episode ends)."""
+        env, max_steps = self.env, self.max_steps
+        episode_steps = self.episode_steps
+        for action in self.chunks[self.chunk]:
+            _, _, terminated, truncated, _ = env.step(action)
+            episode_steps += 1
+            if terminated or truncated or episode_steps == max_steps:
+                env.reset()
+                self.episodes += 1
+                episode_steps = 0
+        self.episode_steps = episode_steps
+        self.steps += self.steps_per_call
+        self.chunk = (self.chunk + 1) % len(self.chunks)
 
 
 class VectorLoop:
@@ -278,8 +294,8 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
     for record in records:
         for entry in ("gym.make", "unwrapped"):
             key = f"{record['env_id']}|{entry}"
-            summary = timed[key].summary()
             loop = loops[key]
+            summary = timed[key].summary(operations_per_call=loop.steps_per_call)
             record[entry] = {
                 "median_us": summary["median_s"] * 1e6,
                 "q1_us": summary["q1_s"] * 1e6,
@@ -287,6 +303,7 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
                 "min_us": summary["min_s"] * 1e6,
                 "rounds": summary["rounds"],
                 "number": summary["number"],
+                "steps_per_call": loop.steps_per_call,
                 "steps_total": loop.steps,
                 "episodes_ended": loop.episodes,
             }

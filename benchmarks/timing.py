@@ -65,13 +65,19 @@ class Timed:
     rounds: int
     number: int
 
-    def summary(self) -> dict[str, float | int]:
-        """The timing fields (not the result) as a JSON-ready dict."""
+    def summary(self, operations_per_call: int = 1) -> dict[str, float | int]:
+        """The timing fields (not the result) as a JSON-ready dict.
+
+        Args:
+            operations_per_call: how many of the measured operations one call of the callable
+                makes; the times are divided by it (per operation).
+        """
+        per = operations_per_call
         return {
-            "median_s": self.median_s,
-            "min_s": self.min_s,
-            "q1_s": self.q1_s,
-            "q3_s": self.q3_s,
+            "median_s": self.median_s / per,
+            "min_s": self.min_s / per,
+            "q1_s": self.q1_s / per,
+            "q3_s": self.q3_s / per,
             "rounds": self.rounds,
             "number": self.number,
         }

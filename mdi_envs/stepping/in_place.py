@@ -5,11 +5,14 @@
 parameters, the outputs and the solver's scratch in one flat float64 buffer that the compiled
 step reads and writes, so that a step from Python costs one dispatch with one array argument
 (below 1 us for the manipulator: numba types each array argument on every call). The inputs
-are still screened, inside the compiled call.
+are still screened, inside the compiled call, which raises the ValueError itself; ``step`` is
+that call bound to the buffer (``functools.partial``), with no Python frame around it.
 """
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -42,7 +45,11 @@ def _buffer_layout(stepper: MoreauJeanStepper) -> list[tuple[str, int]]:
 
 
 def _make_kernel(stepper: MoreauJeanStepper) -> Any:
-    """Compile ``step_in_place(buffer)`` around ``stepper.compiled_step``."""
+    """Compile ``step_in_place(buffer)`` around ``stepper.compiled_step``.
+
+    It raises ValueError with the message of ``_INPUT_PROBLEMS`` before touching the state
+    when the screen finds a problem.
+    """
     record = stepper.compiled_step_batch[1]
     start = len(record) + 1  # the record, then dt
     lines = ["def step_in_place(buffer):",
@@ -53,14 +60,13 @@ def _make_kernel(stepper: MoreauJeanStepper) -> Any:
         start += size
     lines += [
         "    problem = screen(q, u, tau, brake)",
-        "    if problem != 0:",
-        "        return problem",
+        *(f"    if problem == {code}:\n        raise ValueError({message!r})"
+          for code, message in enumerate(_INPUT_PROBLEMS) if code > 0),
         "    step(q, u, tau, brake, dt, p, q_next, u_next, impulses, info,",
         "         (float_scratch, int_scratch.view(np.int64)))",
         f"    for i in range({stepper.num_dofs}):",
         "        q[i] = q_next[i]",
         "        u[i] = u_next[i]",
-        "    return 0",
     ]
     namespace: dict[str, Any] = {"Record": type(record), "step": stepper.compiled_step,
                                  "screen": _screen_inputs, "np": np}
@@ -75,6 +81,11 @@ class InPlaceStepper:
     ``brake_bound`` (k,) (or the state into ``q``, ``u``) as numpy arrays, in place, then call
     ``step()``; read ``q``, ``u`` (n,) and ``impulses`` (c*d + k,) afterwards. All are views
     into one buffer: assign with ``x[:] = ...``, never rebind.
+
+    ``step()`` advances ``q``, ``u`` by one step under ``tau`` and ``brake_bound``, in place,
+    and returns None. It raises ValueError (the state kept) for NaN/inf in q, u or tau, or a
+    negative/NaN brake bound. It is the compiled kernel bound to the buffer, an attribute set
+    per instance.
 
     Example:
         >>> from mdi_envs.mechanics import BlockableManipulator
@@ -92,7 +103,6 @@ class InPlaceStepper:
         key = (stepper.compiled_step, type(record))
         if key not in _KERNELS:
             _KERNELS[key] = _make_kernel(stepper)
-        self._kernel = _KERNELS[key]
         layout = _buffer_layout(stepper)
         self._buffer = np.zeros(len(record) + 1 + sum(size for _, size in layout))
         self._buffer[: len(record)] = record
@@ -103,22 +113,13 @@ class InPlaceStepper:
             views.append(self._buffer[start:start + size])
             start += size
         self.q, self.u, self.tau, self.brake_bound, _, _, self.impulses, self._info, _, _ = views
+        self.step: Callable[[], None] = functools.partial(_KERNELS[key], self._buffer)
         for name, value in (("q", q), ("u", u)):
             array = np.asarray(value, dtype=np.float64)
             if array.shape != (stepper.num_dofs,):
                 raise ValueError(f"{name} must have shape ({stepper.num_dofs},), "
                                  f"got {array.shape}")
             getattr(self, name)[:] = array
-
-    def step(self) -> None:
-        """Advance ``q``, ``u`` by one step under ``tau`` and ``brake_bound``, in place.
-
-        Raises:
-            ValueError: NaN/inf in q, u or tau, or a negative/NaN brake bound (state kept).
-        """
-        problem = self._kernel(self._buffer)
-        if problem:
-            raise ValueError(_INPUT_PROBLEMS[problem])
 
     @property
     def status(self) -> SolverStatus:
