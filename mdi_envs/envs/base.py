@@ -35,6 +35,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numba import njit
 
+from mdi_envs._borrowing import borrowing_njit
 from mdi_envs._types import BoolArray, FloatArray
 from mdi_envs.envs._actions import ARRAY_DTYPE_CHARS, TorqueBrakeActions, decode_levels
 from mdi_envs.mechanics.models.base import ModelDefinition
@@ -703,7 +704,9 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     rewards, observations and info of every copy in one compiled call (one dispatch from Python
     per env step), and returns an ``ADVANCE_*`` outcome. Its arguments are two arrays (each
     costs about 0.1 us to type per call, a tuple several): everything else is carved from the
-    ``BatchState`` buffer inside, the parameter record rebuilt from its settings.
+    ``BatchState`` buffer inside, the parameter record rebuilt from its settings. The loop
+    over the copies after the physics (``evaluate``) takes row views of every copy and is
+    compiled without reference counting (``mdi_envs._borrowing``).
     """
     step_batch, record = task.stepper.compiled_step_batch[:2]
     layout = StateLayout.of(task)
@@ -725,7 +728,7 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     success_one = njit(inline="always")(task.success_one)
     info_one = njit(inline="always")(task.info_one)
 
-    @njit
+    @borrowing_njit
     def evaluate(q, u, tau, brake, impulses, physics, c, dt, horizon, effort_weight,  # noqa: ANN001
                  goal_weight, shaping_weight, discount, elapsed, effort, potential, terminated,
                  reward, obs, info):

@@ -24,6 +24,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
+from mdi_envs._borrowing import borrowing_njit
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers._linalg import invert_into
@@ -481,10 +482,15 @@ def make_step_kernels(
                 which is the worst (largest code) over the substeps.
             ws: one workspace from ``make_workspace``, shared by the copies.
         """
-        num_copies = Q.shape[0]
         fws, iws = ws
-        q_next = np.empty(n)
-        u_next = np.empty(n)
+        step_copies(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, fws, iws,
+                    np.empty(n), np.empty(n))
+
+    @borrowing_njit
+    def step_copies(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, fws, iws,  # noqa: ANN001
+                    q_next, u_next):
+        """``step_batch``'s loop over the copies (q_next, u_next: (n,) scratch)."""
+        num_copies = Q.shape[0]
         for e in range(num_copies):
             worst = 0.0
             q, u, tau, brake, impulses, info = Q[e], U[e], TAU[e], BRAKE[e], IMPULSES[e], INFO[e]

@@ -52,6 +52,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from mdi_envs._borrowing import borrowing_njit
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core, workspace_in
@@ -148,7 +149,7 @@ def make_spatial_step_kernels(
     k_at, wf_at, qf_at, r_at, rho_at = at["K"], at["Wf"], at["qf"], at["r"], at["rho"]
     best_at, newton_at = at["r_best"], at["newton"]
 
-    @njit
+    @njit(inline="always")
     def views_of(ws):  # noqa: ANN001, ANN202
         """The step's arrays carved from the (float, int) workspace buffers, once per call."""
         fws, iws = ws
@@ -164,7 +165,7 @@ def make_spatial_step_kernels(
             workspace_in(fws[newton_at:], c3), iws[1:1 + c],
         )
 
-    @njit
+    @borrowing_njit
     def advance(q, u, tau, dt, p, q_out, u_out, impulses, info, views):  # noqa: ANN001
         """One step on the carved workspace ``views`` (other arguments as ``step``)."""
         (fws, mass_ready, qm, Minv, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho,
@@ -342,7 +343,7 @@ def make_spatial_step_kernels(
         info[INFO_LIFTED_CONTACTS] = lifted
         info[INFO_MODE] = slip_mode(sliding)
 
-    @njit
+    @borrowing_njit
     def step(q, u, tau, brake_bound, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
         """Advance one step of length dt [s].
 
@@ -371,10 +372,14 @@ def make_spatial_step_kernels(
                 the status, which is the worst (largest code) over the substeps.
             ws: one workspace from ``make_spatial_workspace``, shared by the copies.
         """
+        step_copies(Q, U, TAU, dt, p, num_substeps, IMPULSES, INFO, views_of(ws), np.empty(n),
+                    np.empty(n))
+
+    @borrowing_njit
+    def step_copies(Q, U, TAU, dt, p, num_substeps, IMPULSES, INFO, views, q_next,  # noqa: ANN001
+                    u_next):
+        """``step_batch``'s loop over the copies (q_next, u_next: (n,) scratch)."""
         num_copies = Q.shape[0]
-        q_next = np.empty(n)
-        u_next = np.empty(n)
-        views = views_of(ws)
         for e in range(num_copies):
             worst = 0.0
             q, u, tau, impulses, info = Q[e], U[e], TAU[e], IMPULSES[e], INFO[e]

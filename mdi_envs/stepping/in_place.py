@@ -16,8 +16,8 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from mdi_envs._borrowing import borrowing_njit
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers.status import SolverStatus
 from mdi_envs.stepping._kernel import INFO_STATUS
@@ -71,7 +71,7 @@ def _make_kernel(stepper: MoreauJeanStepper) -> Any:
     namespace: dict[str, Any] = {"Record": type(record), "step": stepper.compiled_step,
                                  "screen": _screen_inputs, "np": np}
     exec("\n".join(lines), namespace)  # noqa: S102 - generated from the model's sizes
-    return njit(namespace["step_in_place"])
+    return borrowing_njit(namespace["step_in_place"])
 
 
 class InPlaceStepper:

@@ -269,7 +269,7 @@ def workspace_size(n: int) -> int:
     return _NUM_VECTORS * n + 2 * 9 * (n // 3) + 2 * n * n
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def workspace_in(buffer: FloatArray, n: int) -> Workspace:
     """Scratch arrays of ``newton_ac_core`` as views into ``buffer`` (>= ``workspace_size(n)``).
 
