@@ -16,6 +16,10 @@ decorated here follows:
 * no array it creates outlives the call (it returns scalars or None);
 * the functions it calls that are not inlined return no arrays (such a new reference would
   never be released: the caller's buffer would leak).
+
+numba compiles a callee first reached from a caller with the caller's ``_nrt`` unless the
+callee sets it: every non-inlined function called from one decorated here declares
+``_nrt=True`` (else, compiled first from here, an allocation inside it fails to compile).
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ from numba import njit
 from mdi_envs._types import FloatArray
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool:
     """Solve ``A x = b`` by Gaussian elimination with partial pivoting, in place.
 
@@ -69,7 +69,7 @@ def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool
 
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
                              rel_pivot_tol: float, rel_consistency_tol: float) -> bool:
     """Solve a possibly singular but consistent ``A x = b`` by complete pivoting, in place.
@@ -143,7 +143,7 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def invert_into(A: FloatArray, out: FloatArray, work: FloatArray, column: FloatArray) -> bool:
     """Write A^-1 into ``out`` by one LU solve per column (for the stepper's small matrices).
 
@@ -183,7 +183,7 @@ def invert_into(A: FloatArray, out: FloatArray, work: FloatArray, column: FloatA
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def dominates(A: FloatArray, M: FloatArray, fraction: float, work: FloatArray) -> bool:
     """Whether the symmetric part of A - fraction M is positive definite (A, M: (n, n)).
 

@@ -395,7 +395,7 @@ def make_spatial_step_kernels(
     return step, step_batch
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def _static_start(n0, scale, r):  # noqa: ANN001
     """Set r to the static loads N0 * scale (clipped at 0) with no friction (scale 0: r = 0)."""
     for i in range(n0.shape[0]):

@@ -336,7 +336,7 @@ _INPUT_PROBLEMS = (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def _screen_inputs(q: FloatArray, u: FloatArray, tau: FloatArray, brake: FloatArray) -> int:
     """0 if the step's inputs are valid, else the index of the problem in ``_INPUT_PROBLEMS``."""
     for v in q:

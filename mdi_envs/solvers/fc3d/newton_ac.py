@@ -406,7 +406,7 @@ def _search_direction(
     return -g_norm2, False
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def newton_ac_core(
     W: FloatArray,
     q: FloatArray,
