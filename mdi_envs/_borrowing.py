@@ -18,8 +18,9 @@ decorated here follows:
   never be released: the caller's buffer would leak).
 
 numba compiles a callee first reached from a caller with the caller's ``_nrt`` unless the
-callee sets it: every non-inlined function called from one decorated here declares
-``_nrt=True`` (else, compiled first from here, an allocation inside it fails to compile).
+callee sets it: every non-inlined function called from one decorated here passes
+``REFERENCE_COUNTED`` to ``njit`` (else, compiled first from here, an allocation inside it
+fails to compile, and its views go uncounted).
 """
 
 from __future__ import annotations
@@ -29,10 +30,14 @@ from typing import Any
 
 from numba import njit
 
+REFERENCE_COUNTED: dict[str, bool] = {"_nrt": True}
+"""``njit`` options of a function called (not inlined) from a ``borrowing_njit`` one: keep
+numba's reference counting there rather than inherit its absence."""
+
 
 def borrowing_njit(function: Callable[..., Any]) -> Any:
     """``numba.njit(function)`` without reference counting (see the module docstring)."""
     return njit(_nrt=False)(function)
 
 
-__all__ = ["borrowing_njit"]
+__all__ = ["REFERENCE_COUNTED", "borrowing_njit"]

@@ -10,10 +10,11 @@ import math
 
 from numba import njit
 
+from mdi_envs._borrowing import REFERENCE_COUNTED
 from mdi_envs._types import FloatArray
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool:
     """Solve ``A x = b`` by Gaussian elimination with partial pivoting, in place.
 
@@ -69,7 +70,7 @@ def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool
 
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
                              rel_pivot_tol: float, rel_consistency_tol: float) -> bool:
     """Solve a possibly singular but consistent ``A x = b`` by complete pivoting, in place.
@@ -143,7 +144,7 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
     return True
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def invert_into(A: FloatArray, out: FloatArray, work: FloatArray, column: FloatArray) -> bool:
     """Write A^-1 into ``out`` by one LU solve per column (for the stepper's small matrices).
 
@@ -183,7 +184,7 @@ def invert_into(A: FloatArray, out: FloatArray, work: FloatArray, column: FloatA
     return True
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def dominates(A: FloatArray, M: FloatArray, fraction: float, work: FloatArray) -> bool:
     """Whether the symmetric part of A - fraction M is positive definite (A, M: (n, n)).
 

@@ -24,7 +24,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
-from mdi_envs._borrowing import borrowing_njit
+from mdi_envs._borrowing import REFERENCE_COUNTED, borrowing_njit
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers._linalg import invert_into
@@ -280,7 +280,7 @@ def make_step_kernels(
         solve_active_set(q, u, brake_bound, dt, motion, num_rows, num_x, num_eq, q_out, u_out,
                          impulses, info, fws, iws)
 
-    @njit(_nrt=True)  # explicit: not inherited from a borrowing caller
+    @njit(**REFERENCE_COUNTED)
     def solve_active_set(q, u, brake_bound, dt, motion, num_rows, num_x, num_eq,  # noqa: ANN001
                          q_out, u_out, impulses, info, fws, iws):
         """The step's complementarity problem on the active set ``advance`` found, and its end.
@@ -406,7 +406,7 @@ def make_step_kernels(
             u_out[j] = acc
             q_out[j] = qm[j] + 0.5 * dt * acc
 
-    @njit(_nrt=True)  # explicit: not inherited from a borrowing caller
+    @njit(**REFERENCE_COUNTED)
     def located_advance(q, u, tau, brake_bound, dt, p, q_out, u_out,  # noqa: ANN001
                         impulses, info, fws, iws):
         """``advance``, but a step in which an open contact closes is split at the impact.
@@ -506,7 +506,7 @@ def make_step_kernels(
     return step, step_batch
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def _first_root(c0: float, c1: float, c2: float, limit: float) -> float:
     """The smallest root s in (0, limit] of c0 + c1 s + c2 s^2.
 
@@ -528,7 +528,7 @@ def _first_root(c0: float, c1: float, c2: float, limit: float) -> float:
     return limit * c0 / (c0 - (c0 + limit * (c1 + limit * c2)))
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def _add_row(A, a, row, G, S, s0, gfree, gpre, r, eps, num_rows, size):  # noqa: ANN001
     """A[row, :] += (G S)[r, :] and a[row] += (G s0)[r] + gfree[r] + eps gpre[r] (xi of row r)."""
     for s in range(size):
@@ -542,7 +542,7 @@ def _add_row(A, a, row, G, S, s0, gfree, gpre, r, eps, num_rows, size):  # noqa:
     a[row] += acc
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def _solve_mlcp(A, a, num_x, num_eq, direct_solve_max_size, v, Mred, qred, z, T,  # noqa: ANN001
                 basis, row_of, slot_of, slot_var, pivot_row, Aee, Aee_inv, lu_work, lu_col):
     """Solve [x; y] from 0 <= x _|_ A_xx x + A_xy y + a_x >= 0, A_yx x + A_yy y + a_y = 0.

@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from mdi_envs._borrowing import borrowing_njit
+from mdi_envs._borrowing import REFERENCE_COUNTED, borrowing_njit
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core, workspace_in
@@ -395,7 +395,7 @@ def make_spatial_step_kernels(
     return step, step_batch
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def _static_start(n0, scale, r):  # noqa: ANN001
     """Set r to the static loads N0 * scale (clipped at 0) with no friction (scale 0: r = 0)."""
     for i in range(n0.shape[0]):

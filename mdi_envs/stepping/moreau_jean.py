@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numba import njit
 
+from mdi_envs._borrowing import REFERENCE_COUNTED
 from mdi_envs._types import FloatArray
 from mdi_envs.mechanics.compiled import compile_equations
 from mdi_envs.mechanics.models.base import ModelDefinition
@@ -336,7 +337,7 @@ _INPUT_PROBLEMS = (
 )
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def _screen_inputs(q: FloatArray, u: FloatArray, tau: FloatArray, brake: FloatArray) -> int:
     """0 if the step's inputs are valid, else the index of the problem in ``_INPUT_PROBLEMS``."""
     for v in q:

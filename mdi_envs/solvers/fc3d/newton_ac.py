@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from mdi_envs._borrowing import REFERENCE_COUNTED
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers._linalg import lu_solve_inplace, solve_consistent_inplace
 from mdi_envs.solvers._registry import (
@@ -406,7 +407,7 @@ def _search_direction(
     return -g_norm2, False
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True, **REFERENCE_COUNTED)
 def newton_ac_core(
     W: FloatArray,
     q: FloatArray,
