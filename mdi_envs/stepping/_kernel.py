@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from mdi_envs._borrowing import REFERENCE_COUNTED, borrowing_njit
+from mdi_envs._views import array_view
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers._linalg import invert_into
@@ -142,10 +143,9 @@ def _make_carver(layout: Layout) -> Any:
     """
     lines = ["def carve(buffer):"]
     for name, (offset, shape) in layout.items():
-        size = int(np.prod(shape))
-        lines.append(f"    {name} = buffer[{offset}:{offset + size}].reshape({shape!r})")
+        lines.append(f"    {name} = array_view(buffer, {offset}, {shape!r})")
     lines.append(f"    return ({', '.join(layout)},)")
-    namespace: dict[str, Any] = {}
+    namespace: dict[str, Any] = {"array_view": array_view}
     exec("\n".join(lines), namespace)  # noqa: S102 - generated from the layout's constants
     return njit(namespace["carve"])
 

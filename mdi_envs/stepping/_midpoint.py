@@ -19,6 +19,7 @@ from typing import Any
 
 from numba import njit
 
+from mdi_envs._views import array_view
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers._linalg import invert_into
 
@@ -81,11 +82,7 @@ class _Flat:
 
     def view(self, name: str) -> str:
         shape = self.shapes[name]
-        start = self.offsets[name]
-        size = 1
-        for extent in shape:
-            size *= extent
-        return f"{self.buffer}[{start}:{start + size}].reshape({shape!r})"
+        return f"array_view({self.buffer}, {self.offsets[name]}, {shape!r})"
 
 
 def _free_motion_source(n: int, m: int, velocity_forces: bool, reuse_mass: bool) -> str:
@@ -221,6 +218,7 @@ def make_free_motion(model: type[ModelDefinition], reuse_constant_mass: bool) ->
     reuse_mass = reuse_constant_mass and model.HAS_CONSTANT_MASS and not velocity_forces
     source = _free_motion_source(model.NUM_DOFS, model.NUM_INPUTS, velocity_forces, reuse_mass)
     namespace: dict[str, Any] = {
+        "array_view": array_view,
         "math": math,
         "forces": njit(model.forces),
         "inputs": njit(model.input_matrix),

@@ -53,6 +53,7 @@ import numpy as np
 from numba import njit
 
 from mdi_envs._borrowing import REFERENCE_COUNTED, borrowing_njit
+from mdi_envs._views import array_view
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core, workspace_in
@@ -154,13 +155,13 @@ def make_spatial_step_kernels(
         """The step's arrays carved from the (float, int) workspace buffers, once per call."""
         fws, iws = ws
         return (
-            fws, iws[0:1], fws[qm_at:qm_at + n], fws[minv_at:minv_at + n * n].reshape((n, n)),
-            fws[ufree_at:ufree_at + n], fws[wc_at:wc_at + c3 * n].reshape((c3, n)),
-            fws[mu_at:mu_at + c], fws[wt_at:wt_at + c2 * n].reshape((c2, n)),
-            fws[minvwt_at:minvwt_at + n * c2].reshape((n, c2)),
-            fws[g_at:g_at + c2 * c2].reshape((c2, c2)), fws[bt_at:bt_at + c2],
-            fws[n0_at:n0_at + c], fws[k_at:k_at + c * c2].reshape((c, c2)),
-            fws[wf_at:wf_at + c3 * c3].reshape((c3, c3)), fws[qf_at:qf_at + c3],
+            fws, iws[0:1], fws[qm_at:qm_at + n], array_view(fws, minv_at, (n, n)),
+            fws[ufree_at:ufree_at + n], array_view(fws, wc_at, (c3, n)),
+            fws[mu_at:mu_at + c], array_view(fws, wt_at, (c2, n)),
+            array_view(fws, minvwt_at, (n, c2)),
+            array_view(fws, g_at, (c2, c2)), fws[bt_at:bt_at + c2],
+            fws[n0_at:n0_at + c], array_view(fws, k_at, (c, c2)),
+            array_view(fws, wf_at, (c3, c3)), fws[qf_at:qf_at + c3],
             fws[r_at:r_at + c3], fws[rho_at:rho_at + c], fws[best_at:best_at + c3],
             workspace_in(fws[newton_at:], c3), iws[1:1 + c],
         )

@@ -48,6 +48,7 @@ from numba import njit
 
 from mdi_envs._borrowing import REFERENCE_COUNTED
 from mdi_envs._types import FloatArray
+from mdi_envs._views import array_view
 from mdi_envs.solvers._linalg import lu_solve_inplace, solve_consistent_inplace
 from mdi_envs.solvers._registry import (
     SolverOptions,
@@ -284,10 +285,10 @@ def workspace_in(buffer: FloatArray, n: int) -> Workspace:
         buffer[n:2 * n],  # velocity of the proximal sub-problem
         buffer[2 * n:3 * n],  # proximal centre
         buffer[3 * n:4 * n],  # phi
-        buffer[blocks:blocks + 9 * nc].reshape((nc, 3, 3)),  # A
-        buffer[blocks + 9 * nc:matrices].reshape((nc, 3, 3)),  # B
-        buffer[matrices:matrices + n * n].reshape((n, n)),  # J
-        buffer[matrices + n * n:matrices + 2 * n * n].reshape((n, n)),  # factored J (or LM)
+        array_view(buffer, blocks, (nc, 3, 3)),  # A
+        array_view(buffer, blocks + 9 * nc, (nc, 3, 3)),  # B
+        array_view(buffer, matrices, (n, n)),  # J
+        array_view(buffer, matrices + n * n, (n, n)),  # factored J (or LM)
         buffer[4 * n:5 * n],  # d
         buffer[5 * n:6 * n],  # grad = J^T phi
         buffer[6 * n:7 * n],  # (W + sigma D) d
