@@ -36,8 +36,8 @@ over) the problem can have several solutions and Newton may still fail: the stat
 The wheels' lateral rows are identical (both lie on the axle), so G_TT is singular while both
 wheels roll: the split of the lateral impulse between them is not determined by the rigid model
 (any split inside the cones is a solution; the motion and the normal impulses, which depend on
-its sum only, are). The Newton method solves its then singular but consistent systems by
-complete pivoting; the warm start selects the split.
+its sum only, are). The Newton method solves its then singular but consistent systems with
+the redundant increment at 0; the warm start selects the split.
 
 Mode (the paper's Table 1) from the slip after the step: contact i slides when
 ``|W_T,i u+| > SLIP_RTOL * v_ref + SLIP_ATOL * s P0``, with v_ref the largest single term

@@ -116,7 +116,7 @@ def test_inputs_are_overwritten() -> None:
 
 @pytest.mark.parametrize("seed", range(5))
 def test_consistent_singular_systems_are_solved_exactly(seed: int) -> None:
-    """Duplicated rows (rank n - 2): partial pivoting gives up, complete pivoting solves A x = b."""
+    """Duplicated rows (rank n - 2): LU gives up, the elimination with deferred columns solves."""
     rng = np.random.default_rng(seed)
     n = 9
     A = rng.standard_normal((n, n))
@@ -133,6 +133,41 @@ def test_consistent_singular_systems_are_solved_exactly(seed: int) -> None:
     y = M @ x_true
     assert solve_consistent_inplace(M.copy(), y, np.empty(n), 1e-14, 1e-10)
     np.testing.assert_allclose(y, x_true, rtol=1e-9, atol=1e-9)
+    # ... computed by exactly LU's elimination
+    lu_x = M @ x_true
+    assert lu_solve_inplace(M.copy(), lu_x, 1e-14)
+    np.testing.assert_array_equal(y, lu_x)
+
+
+@pytest.mark.parametrize("seed", range(5))
+@pytest.mark.parametrize("twins", [(2, 5), (0, 3), (6, 8)])
+def test_duplicated_columns_are_deferred(seed: int, twins: tuple[int, int]) -> None:
+    """Two contacts on one line: a symmetric J with a duplicated row and column.
+
+    The second twin's column has no pivot once the first is eliminated: it is deferred, its
+    unknown is 0 and the rest solve every equation.
+    """
+    rng = np.random.default_rng(seed)
+    n = 9
+    first, second = twins
+    root = rng.standard_normal((n, n))
+    A = root @ root.T
+    A[second] = A[first]
+    A[:, second] = A[:, first]
+    b = A @ rng.standard_normal(n)
+    x = b.copy()
+    assert solve_consistent_inplace(A.copy(), x, np.empty(n), 1e-14, 1e-10)
+    np.testing.assert_allclose(A @ x, b, rtol=0, atol=1e-12 * np.abs(b).max())
+    assert x[first] == 0.0 or x[second] == 0.0
+
+
+def test_a_zero_leading_column_is_deferred() -> None:
+    A = np.array([[0.0, 1.0, 2.0], [0.0, 3.0, 1.0], [0.0, 1.0, 1.0]])
+    A[2] = A[0] + A[1]  # rank 2: column 0 and a row redundant
+    x_true = np.array([0.0, 1.0, -2.0])
+    x = A @ x_true
+    assert solve_consistent_inplace(A.copy(), x, np.empty(3), 1e-14, 1e-10)
+    np.testing.assert_allclose(x, x_true, rtol=0, atol=1e-14)
 
 
 def test_inconsistent_singular_systems_are_refused() -> None:

@@ -13,14 +13,15 @@ problem (Alart & Curnier, 1991). phi is piecewise smooth in (r, u); on each piec
 
 so an element of the generalized Jacobian is ``J = blockdiag(A) + blockrows(B) W``
 (``alart_curnier_local`` computes phi_i, A_i and B_i of one contact; both this method and the
-Gauss-Seidel method call it). Each step solves ``J d = -phi`` by LU with partial pivoting and
-backtracks on the merit function ``psi = |phi|^2 / 2`` (Armijo). When J is singular to working
-precision, the system is solved by complete pivoting if it is consistent (duplicated rows, as
+Gauss-Seidel method call it). Each step solves ``J d = -phi`` by Gaussian elimination with
+partial pivoting and backtracks on the merit function ``psi = |phi|^2 / 2`` (Armijo). When J
+is singular to working precision the same elimination defers the columns without a pivot
+(``solve_consistent_inplace``) and solves the system if it is consistent (duplicated rows, as
 two contacts on one line in the same state give: the redundant increments are set to 0, which
 keeps the step exact on the current piece). When it is inconsistent or the Newton direction is
-not a descent direction, the step is a
-Levenberg-Marquardt step ``(J^T J + lambda I) d = -J^T phi`` with lambda proportional to |phi|,
-and failing that the steepest-descent direction ``-J^T phi``.
+not a descent direction, the step is a Levenberg-Marquardt step
+``(J^T J + lambda I) d = -J^T phi`` with lambda proportional to |phi|, and failing that the
+steepest-descent direction ``-J^T phi``.
 
 Redundant contacts make W (hence J) singular, and plain Newton then crawls (tiny accepted
 steps) or stalls. After the first such poor step the method switches to proximal-point
@@ -382,13 +383,9 @@ def _search_direction(
         for j in range(n):
             H[i, j] = J[i, j]
         d[i] = -phi[i]
-    solved = lu_solve_inplace(H, d, _PIVOT_TOL)
-    if not solved:  # singular: duplicated rows (redundant contacts) still give a Newton step
-        for i in range(n):
-            for j in range(n):
-                H[i, j] = J[i, j]
-            d[i] = -phi[i]
-        solved = solve_consistent_inplace(H, d, work, _PIVOT_TOL, _CONSISTENCY_TOL)
+    # regular J: LU with partial pivoting; singular (duplicated rows: redundant contacts)
+    # but consistent: still a Newton step, with the redundant increments at 0
+    solved = solve_consistent_inplace(H, d, work, _PIVOT_TOL, _CONSISTENCY_TOL)
     if solved:
         slope = 0.0
         d_norm2 = 0.0
