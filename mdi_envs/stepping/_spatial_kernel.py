@@ -56,7 +56,7 @@ from mdi_envs._borrowing import REFERENCE_COUNTED, borrowing_njit
 from mdi_envs._views import array_view
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
-from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core, workspace_in
+from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
 from mdi_envs.solvers.fc3d.newton_ac import workspace_size as newton_workspace_size
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
 from mdi_envs.stepping._kernel import (
@@ -149,10 +149,11 @@ def make_spatial_step_kernels(
     wt_at, minvwt_at, g_at, bt_at, n0_at = at["WT"], at["MinvWt"], at["G"], at["bT"], at["n0"]
     k_at, wf_at, qf_at, r_at, rho_at = at["K"], at["Wf"], at["qf"], at["r"], at["rho"]
     best_at, newton_at = at["r_best"], at["newton"]
+    newton_size = newton_workspace_size(c3)
 
     @njit(inline="always")
     def views_of(ws):  # noqa: ANN001, ANN202
-        """The step's arrays carved from the (float, int) workspace buffers, once per call."""
+        """The step's arrays carved from the (float, int) workspace buffers."""
         fws, iws = ws
         return (
             fws, iws[0:1], fws[qm_at:qm_at + n], array_view(fws, minv_at, (n, n)),
@@ -163,14 +164,18 @@ def make_spatial_step_kernels(
             fws[n0_at:n0_at + c], array_view(fws, k_at, (c, c2)),
             array_view(fws, wf_at, (c3, c3)), fws[qf_at:qf_at + c3],
             fws[r_at:r_at + c3], fws[rho_at:rho_at + c], fws[best_at:best_at + c3],
-            workspace_in(fws[newton_at:], c3), iws[1:1 + c],
+            fws[newton_at:newton_at + newton_size], iws[1:1 + c],
         )
 
     @borrowing_njit
-    def advance(q, u, tau, dt, p, q_out, u_out, impulses, info, views):  # noqa: ANN001
-        """One step on the carved workspace ``views`` (other arguments as ``step``)."""
+    def advance(q, u, tau, dt, p, q_out, u_out, impulses, info, ws):  # noqa: ANN001
+        """One step (arguments as ``step``).
+
+        It carves its arrays from ``ws`` itself: passing them would flatten twenty views into
+        some two hundred call arguments per step.
+        """
         (fws, mass_ready, qm, Minv, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho,
-         r_best, nws, sliding) = views
+         r_best, nws, sliding) = views_of(ws)
 
         # The warm start, read before the impulses are overwritten.
         warm_load = 0.0
@@ -358,7 +363,7 @@ def make_spatial_step_kernels(
             info: (SPATIAL_INFO_SIZE,) output diagnostics (INFO_* constants).
             ws: (float, int) buffers from ``make_spatial_workspace``.
         """
-        advance(q, u, tau, dt, p, q_out, u_out, impulses, info, views_of(ws))
+        advance(q, u, tau, dt, p, q_out, u_out, impulses, info, ws)
 
     @njit
     def step_batch(Q, U, TAU, BRAKE, dt, p, num_substeps, IMPULSES, INFO, ws):  # noqa: ANN001
@@ -373,11 +378,10 @@ def make_spatial_step_kernels(
                 the status, which is the worst (largest code) over the substeps.
             ws: one workspace from ``make_spatial_workspace``, shared by the copies.
         """
-        step_copies(Q, U, TAU, dt, p, num_substeps, IMPULSES, INFO, views_of(ws), np.empty(n),
-                    np.empty(n))
+        step_copies(Q, U, TAU, dt, p, num_substeps, IMPULSES, INFO, ws, np.empty(n), np.empty(n))
 
     @borrowing_njit
-    def step_copies(Q, U, TAU, dt, p, num_substeps, IMPULSES, INFO, views, q_next,  # noqa: ANN001
+    def step_copies(Q, U, TAU, dt, p, num_substeps, IMPULSES, INFO, ws, q_next,  # noqa: ANN001
                     u_next):
         """``step_batch``'s loop over the copies (q_next, u_next: (n,) scratch)."""
         num_copies = Q.shape[0]
@@ -385,7 +389,7 @@ def make_spatial_step_kernels(
             worst = 0.0
             q, u, tau, impulses, info = Q[e], U[e], TAU[e], IMPULSES[e], INFO[e]
             for _ in range(num_substeps):
-                advance(q, u, tau, dt, p, q_next, u_next, impulses, info, views)
+                advance(q, u, tau, dt, p, q_next, u_next, impulses, info, ws)
                 for j in range(n):
                     q[j] = q_next[j]
                     u[j] = u_next[j]

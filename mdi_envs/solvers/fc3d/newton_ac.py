@@ -80,10 +80,6 @@ _PROX_INCREASE = 10.0
 _PROX_SIGMA_MAX = 1e8
 """Largest proximal weight (relative to ||W_ii||) before the method reports a breakdown."""
 
-Workspace = tuple[FloatArray, ...]
-"""Scratch arrays of ``newton_ac_core`` (see ``make_workspace``)."""
-
-
 @dataclass(frozen=True)
 class NewtonACOptions(SolverOptions):
     """Options of the Alart-Curnier Newton method.
@@ -237,7 +233,7 @@ def alart_curnier_local(
                       with_jacobian)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def alart_curnier(
     mu: FloatArray,
     rho: FloatArray,
@@ -268,15 +264,16 @@ _NUM_VECTORS = 10
 
 @njit(cache=True)
 def workspace_size(n: int) -> int:
-    """Length of the flat float64 buffer ``workspace_in`` carves for a problem of size n = 3 nc."""
+    """Length of the flat float64 scratch buffer of ``newton_ac_core`` for a problem of size n."""
     return _NUM_VECTORS * n + 2 * 9 * (n // 3) + 2 * n * n
 
 
 @njit(cache=True, inline="always")
-def workspace_in(buffer: FloatArray, n: int) -> Workspace:
-    """Scratch arrays of ``newton_ac_core`` as views into ``buffer`` (>= ``workspace_size(n)``).
+def _workspace_in(buffer: FloatArray, n: int) -> tuple[FloatArray, ...]:
+    """The scratch arrays of ``newton_ac_core`` as views into ``buffer`` (``workspace_size(n)``).
 
-    Lets a caller keep the solver's scratch inside its own flat buffer.
+    Carved on each call (a few integer operations each), so that the solver takes one flat
+    buffer: a caller can keep it inside its own, and the call passes one array, not fourteen.
     """
     nc = n // 3
     blocks = _NUM_VECTORS * n
@@ -300,12 +297,12 @@ def workspace_in(buffer: FloatArray, n: int) -> Workspace:
 
 
 @njit(cache=True)
-def make_workspace(n: int) -> Workspace:
-    """Scratch arrays of ``newton_ac_core`` for a problem of size n = 3 nc."""
-    return workspace_in(np.empty(workspace_size(n)), n)
+def make_workspace(n: int) -> FloatArray:
+    """The flat scratch buffer of ``newton_ac_core`` for a problem of size n = 3 nc."""
+    return np.empty(workspace_size(n))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _assemble_jacobian(
     W: FloatArray, A: FloatArray, B: FloatArray, sigma: float, rho: FloatArray, J: FloatArray
 ) -> None:
@@ -355,7 +352,7 @@ def _levenberg_marquardt_step(
     return lu_solve_inplace(H, d, _PIVOT_TOL)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _search_direction(
     J: FloatArray, phi: FloatArray, psi: float, H: FloatArray, d: FloatArray, grad: FloatArray,
     work: FloatArray,
@@ -417,7 +414,7 @@ def newton_ac_core(
     armijo: float,
     max_backtracks: int,
     prox_sigma: float,
-    workspace: Workspace,
+    workspace: FloatArray,
 ) -> tuple[int, int, float]:
     """Semismooth Newton iterations on the Alart-Curnier function of FC3D(W, q, mu).
 
@@ -430,15 +427,16 @@ def newton_ac_core(
         W: (n, n), n = 3 nc. q: (n,). mu, rho: (nc,).
         r: (n,) starting point, overwritten by the iterate (modified in place).
         max_iter, tol, armijo, max_backtracks, prox_sigma: see ``NewtonACOptions``.
-        workspace: ``make_workspace(n)``.
+        workspace: flat scratch of at least ``workspace_size(n)`` entries (``make_workspace``).
 
     Returns:
         (code, steps, residual): code 0 converged (shared residual <= tol), 1 step limit,
         3 breakdown (no progress even with sigma at ``_PROX_SIGMA_MAX``, or with
         ``prox_sigma = 0`` a failed line search); the shared residual of the returned r.
     """
-    u, u_sub, center, phi, A, B, J, H, d, grad, Wd, trial_r, trial_u, trial_phi = workspace
     n = q.shape[0]
+    (u, u_sub, center, phi, A, B, J, H, d, grad, Wd, trial_r, trial_u,
+     trial_phi) = _workspace_in(workspace, n)
     sigma = 0.0
     center_norm = 0.0
     sub_steps = 0
@@ -551,6 +549,5 @@ __all__ = [
     "newton_ac_core",
     "newton_ac_kernel",
     "solve_newton_ac",
-    "workspace_in",
     "workspace_size",
 ]

@@ -131,7 +131,7 @@ def cone_projection(mu: float, x_n: float, x_t1: float, x_t2: float) -> tuple[fl
     return beta, scale * x_t1, scale * x_t2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def compute_velocity(W: FloatArray, q: FloatArray, r: FloatArray, u: FloatArray) -> None:
     """Fill u (n,) with W r + q, for W (n, n), q (n,), r (n,)."""
     n = q.shape[0]
@@ -142,7 +142,7 @@ def compute_velocity(W: FloatArray, q: FloatArray, r: FloatArray, u: FloatArray)
         u[i] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def residual_from_velocity(q: FloatArray, mu: FloatArray, r: FloatArray, u: FloatArray) -> float:
     """The shared residual of r (3 nc,) given its velocity u = W r + q (3 nc,)."""
     acc = 0.0
