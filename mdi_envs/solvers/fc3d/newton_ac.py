@@ -289,7 +289,7 @@ def _workspace_in(buffer: FloatArray, n: int) -> tuple[FloatArray, ...]:
         array_view(buffer, matrices + n * n, (n, n)),  # factored J (or LM)
         buffer[4 * n:5 * n],  # d
         buffer[5 * n:6 * n],  # grad = J^T phi
-        buffer[6 * n:7 * n],  # (W + sigma D) d
+        buffer[6 * n:7 * n],  # W trial r + q (and the search direction's scratch)
         buffer[7 * n:8 * n],  # trial r
         buffer[8 * n:9 * n],  # trial u
         buffer[9 * n:10 * n],  # trial phi
@@ -435,7 +435,7 @@ def newton_ac_core(
         ``prox_sigma = 0`` a failed line search); the shared residual of the returned r.
     """
     n = q.shape[0]
-    (u, u_sub, center, phi, A, B, J, H, d, grad, Wd, trial_r, trial_u,
+    (u, u_sub, center, phi, A, B, J, H, d, grad, trial_v, trial_r, trial_u,
      trial_phi) = _workspace_in(workspace, n)
     sigma = 0.0
     center_norm = 0.0
@@ -461,19 +461,19 @@ def newton_ac_core(
             center_norm = np.sqrt(2.0 * psi)
             sub_steps = 0
         _assemble_jacobian(W, A, B, sigma, rho, J)
-        slope, is_newton = _search_direction(J, phi, psi, H, d, grad, Wd)
-        for i in range(n):
-            acc = sigma * d[i] / rho[i // 3]
-            for j in range(n):
-                acc += W[i, j] * d[j]
-            Wd[i] = acc
+        slope, is_newton = _search_direction(J, phi, psi, H, d, grad, trial_v)
         t = 1.0
         accepted = False
         if slope < 0.0:
             for _ in range(max_backtracks):
                 for i in range(n):
                     trial_r[i] = r[i] + t * d[i]
-                    trial_u[i] = u_sub[i] + t * Wd[i]
+                # the trial's velocity afresh, not u + t W d: no accumulated rounding, and an
+                # accepted first trial needs no further product with W
+                compute_velocity(W, q, trial_r, trial_v)
+                for i in range(n):
+                    shift = sigma * (trial_r[i] - center[i]) / rho[i // 3] if sigma > 0.0 else 0.0
+                    trial_u[i] = trial_v[i] + shift
                 trial_psi = alart_curnier(mu, rho, trial_r, trial_u, trial_phi, A, B, False)
                 if trial_psi <= psi + armijo * t * slope:
                     accepted = True
@@ -482,7 +482,7 @@ def newton_ac_core(
         if accepted:
             for i in range(n):
                 r[i] = trial_r[i]
-            compute_velocity(W, q, r, u)  # fresh, not u + t W d: no accumulated rounding
+                u[i] = trial_v[i]
             sub_steps += 1
         if sigma == 0.0:
             is_poor = not accepted or not is_newton or t < _SLOW_STEP
