@@ -14,6 +14,37 @@ from mdi_envs._borrowing import REFERENCE_COUNTED
 from mdi_envs._types import FloatArray
 
 
+@njit(cache=True, inline="always")
+def _column_pivot(A: FloatArray, k: int) -> tuple[int, float]:
+    """Partial pivoting: the row p >= k with the largest |A[p, k]|, and that value."""
+    p = k
+    best = abs(A[k, k])
+    for i in range(k + 1, A.shape[0]):
+        a = abs(A[i, k])
+        if a > best:
+            best = a
+            p = i
+    return p, best
+
+
+@njit(cache=True, inline="always")
+def _eliminate_below(A: FloatArray, b: FloatArray, k: int, p: int) -> None:
+    """Swap rows k and p of (A, b), then eliminate column k below row k (multipliers kept)."""
+    n = A.shape[0]
+    if p != k:
+        for j in range(n):
+            A[k, j], A[p, j] = A[p, j], A[k, j]
+        b[k], b[p] = b[p], b[k]
+    inv = 1.0 / A[k, k]
+    for i in range(k + 1, n):
+        f = A[i, k] * inv
+        if f != 0.0:
+            A[i, k] = f
+            for j in range(k + 1, n):
+                A[i, j] -= f * A[k, j]
+            b[i] -= f * b[k]
+
+
 @njit(cache=True, **REFERENCE_COUNTED)
 def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool:
     """Solve ``A x = b`` by Gaussian elimination with partial pivoting, in place.
@@ -39,27 +70,10 @@ def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool
         return False
     threshold = rel_pivot_tol * scale
     for k in range(n):
-        p = k
-        best = abs(A[k, k])
-        for i in range(k + 1, n):
-            a = abs(A[i, k])
-            if a > best:
-                best = a
-                p = i
+        p, best = _column_pivot(A, k)
         if best <= threshold:
             return False
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-            b[k], b[p] = b[p], b[k]
-        inv = 1.0 / A[k, k]
-        for i in range(k + 1, n):
-            f = A[i, k] * inv
-            if f != 0.0:
-                A[i, k] = f
-                for j in range(k + 1, n):
-                    A[i, j] -= f * A[k, j]
-                b[i] -= f * b[k]
+        _eliminate_below(A, b, k, p)
     for i in range(n - 1, -1, -1):
         s = b[i]
         for j in range(i + 1, n):
@@ -108,13 +122,7 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
     last = n - 1  # the last column not deferred
     k = 0
     while k <= last:
-        p = k
-        best = abs(A[k, k])
-        for i in range(k + 1, n):
-            a = abs(A[i, k])
-            if a > best:
-                best = a
-                p = i
+        p, best = _column_pivot(A, k)
         if not best > threshold:  # no pivot among the remaining rows: defer column k
             if k < last:
                 for i in range(n):
@@ -122,17 +130,7 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
             swaps[last] = k
             last -= 1
             continue
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-            b[k], b[p] = b[p], b[k]
-        inv = 1.0 / A[k, k]
-        for i in range(k + 1, n):
-            f = A[i, k] * inv
-            if f != 0.0:
-                for j in range(k + 1, n):
-                    A[i, j] -= f * A[k, j]
-                b[i] -= f * b[k]
+        _eliminate_below(A, b, k, p)
         k += 1
     rank = k
     for i in range(rank, n):
