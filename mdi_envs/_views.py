@@ -3,7 +3,8 @@
 The compiled steps keep their scratch arrays in one flat float64 buffer (a single argument is
 cheap to pass from Python) and carve their matrices from it on every call. numba's
 ``buffer[a:b].reshape(shape)`` goes through a generic C helper that re-derives the strides and
-checks contiguity: eight such reshapes took 0.25 µs, a sixth of a robot step. ``array_view``
+checks contiguity on every call (it showed in perf of the robot's step, eleven views per call).
+``array_view``
 builds the same view from the buffer's data pointer and stride directly (a few integer
 operations). The view shares the buffer's memory and its reference count, as a slice does.
 

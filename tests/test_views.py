@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import weakref
 
 import numpy as np
 from numba import njit, typeof
@@ -36,6 +37,13 @@ def test_writes_reach_the_buffer_and_views_keep_it_alive() -> None:
     buffer = np.zeros(16)
     _write_through(buffer)  # compiled without reference counting: a borrowed view
     assert buffer[7] == -1.0 and np.count_nonzero(buffer) == 1
-    matrix = _views(np.arange(40.0))[0]
-    gc.collect()  # the temporary buffer is referenced only through the returned view
+    source = np.arange(40.0)
+    alive = weakref.ref(source)
+    matrix = _views(source)[0]
+    del source
+    gc.collect()
+    assert alive() is not None  # referenced only through the returned view
     np.testing.assert_array_equal(matrix, np.arange(5.0, 17.0).reshape(3, 4))
+    del matrix
+    gc.collect()
+    assert alive() is None  # and released with it

@@ -97,9 +97,9 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
     right-hand side's last n - r entries are at most ``rel_consistency_tol * max|b|``; then x
     solves the r independent equations with the free unknowns at 0 (a basic solution; for
     duplicated rows, an exact solution of all of them). A duplicated row is eliminated to
-    exact zeros (its multiplier is 1). One pass costs about one regular solve: for the robot's
-    singular 9 x 9 Newton systems, a failed LU followed by complete pivoting cost 3.5 times as
-    much.
+    exact zeros (its multiplier is 1). One pass costs about one regular solve, where a failed
+    LU followed by complete pivoting (the former path for the robot's singular Newton systems)
+    cost the LU plus a complete-pivoting search over every remaining entry at every step.
 
     Args:
         A: (n, n) matrix; overwritten by its factors. b: (n,) right-hand side; overwritten by

@@ -402,6 +402,19 @@ def _search_direction(
     return -g_norm2, False
 
 
+@njit(cache=True, inline="always")
+def _proximal_velocity(
+    v: FloatArray, r: FloatArray, center: FloatArray, sigma: float, rho: FloatArray,
+    out: FloatArray,
+) -> None:
+    """The proximal sub-problem's velocity at r: out = v + sigma D (r - center).
+
+    D = blockdiag(I / rho_i); v = W r + q; out = v when sigma = 0. All (n,) but rho (nc,).
+    """
+    for i in range(v.shape[0]):
+        out[i] = v[i] + sigma * (r[i] - center[i]) / rho[i // 3] if sigma > 0.0 else v[i]
+
+
 @njit(cache=True, **REFERENCE_COUNTED)
 def newton_ac_core(
     W: FloatArray,
@@ -447,8 +460,7 @@ def newton_ac_core(
             return CODE_CONVERGED, step, residual
         if step == max_iter:
             break
-        for i in range(n):
-            u_sub[i] = u[i] + sigma * (r[i] - center[i]) / rho[i // 3] if sigma > 0.0 else u[i]
+        _proximal_velocity(u, r, center, sigma, rho, u_sub)
         psi = alart_curnier(mu, rho, r, u_sub, phi, A, B, True)
         if sigma > 0.0 and sub_steps > 0 and np.sqrt(2.0 * psi) <= _PROX_ETA * center_norm:
             # the sub-problem is solved well enough: move the centre to r
@@ -471,9 +483,7 @@ def newton_ac_core(
                 # the trial's velocity afresh, not u + t W d: no accumulated rounding, and an
                 # accepted first trial needs no further product with W
                 compute_velocity(W, q, trial_r, trial_v)
-                for i in range(n):
-                    shift = sigma * (trial_r[i] - center[i]) / rho[i // 3] if sigma > 0.0 else 0.0
-                    trial_u[i] = trial_v[i] + shift
+                _proximal_velocity(trial_v, trial_r, center, sigma, rho, trial_u)
                 trial_psi = alart_curnier(mu, rho, trial_r, trial_u, trial_phi, A, B, False)
                 if trial_psi <= psi + armijo * t * slope:
                     accepted = True
