@@ -25,11 +25,14 @@ the cone conditions give isotropic Coulomb friction with normal impulses that de
 friction impulses. The complementarity is invariant under the positive scale s, which only
 makes both kinds of rows commensurate. The problem is solved in units of the weight impulse
 P0 = sum(N0) dt and the velocity s P0 (r / P0, u / (s P0)), to an absolute tolerance
-``NEWTON_TOL`` in these units, by the compiled semismooth Newton method on the Alart-Curnier
-function (``newton_ac_core``), warm-started from the impulses passed in (the previous
-step's). If that does not converge it restarts from the static loads without friction, then
-from zero, and otherwise keeps the iterate with the smallest residual (``INFO_ITERATIONS``
-counts all Newton steps).
+``NEWTON_TOL`` in these units, warm-started from the impulses passed in (the previous step's).
+First by semismooth Newton on the friction impulses alone (``newton_load_transfer``): with
+normal rows that are a load law, Signorini's condition has the closed form
+P_N = max(0, N0 dt + K P_T), which leaves 2c unknowns (6 for the robot, not 9). If that does
+not converge within ``LOAD_TRANSFER_MAX_ITER`` steps, the full FC3D problem by the semismooth
+Newton method on the Alart-Curnier function (``newton_ac_core``), from the warm start, then
+from the static loads without friction, then from zero, keeping otherwise the iterate with the
+smallest residual (``INFO_ITERATIONS`` counts all Newton steps).
 Where the load transfer is strong enough to lift contacts (a tall, narrow robot that would tip
 over) the problem can have several solutions and Newton may still fail: the status says so.
 
@@ -56,7 +59,11 @@ from mdi_envs._borrowing import REFERENCE_COUNTED, borrowing_njit
 from mdi_envs._views import array_view
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
-from mdi_envs.solvers.fc3d.newton_ac import newton_ac_core
+from mdi_envs.solvers.fc3d.load_transfer import (
+    load_transfer_workspace_size,
+    newton_load_transfer,
+)
+from mdi_envs.solvers.fc3d.newton_ac import contact_weights, newton_ac_core
 from mdi_envs.solvers.fc3d.newton_ac import workspace_size as newton_workspace_size
 from mdi_envs.solvers.status import CODE_BREAKDOWN, CODE_CONVERGED, CODE_INACCURATE
 from mdi_envs.stepping._kernel import (
@@ -88,6 +95,8 @@ NEWTON_TOL = 1e-12
 NEWTON_TOL_FLOOR = 1e-14
 """Smallest relative tolerance asked of the solver (its residual is relative to |q|)."""
 NEWTON_MAX_ITER = 100
+LOAD_TRANSFER_MAX_ITER = 20
+"""Newton steps on the friction impulses alone before the full FC3D problem is solved."""
 SLIP_RTOL = 1e-7
 """A contact slides when its slip exceeds this fraction of the speed scale v_ref ..."""
 SLIP_ATOL = 1e-8
@@ -100,8 +109,9 @@ def _spatial_shapes(model: type[ModelDefinition]) -> dict[str, tuple[int, ...]]:
     return {
         **free_motion_shapes(n, m), "Wc": (3 * c, n), "mu": (c,), "WT": (2 * c, n),
         "MinvWt": (n, 2 * c), "G": (2 * c, 2 * c), "bT": (2 * c,), "n0": (c,),
-        "K": (c, 2 * c), "Wf": (3 * c, 3 * c), "qf": (3 * c,), "r": (3 * c,), "rho": (c,),
-        "r_best": (3 * c,), "newton": (newton_workspace_size(3 * c),),
+        "K": (c, 2 * c), "Wf": (3 * c, 3 * c), "qf": (3 * c,), "r": (3 * c,),
+        "r_best": (3 * c,), "r_warm": (3 * c,), "newton": (newton_workspace_size(3 * c),),
+        "load_transfer": (load_transfer_workspace_size(c),),
     }
 
 
@@ -147,9 +157,11 @@ def make_spatial_step_kernels(
     at, _ = offsets_of(_spatial_shapes(model))
     qm_at, minv_at, ufree_at, wc_at, mu_at = at["qm"], at["Minv"], at["ufree"], at["Wc"], at["mu"]
     wt_at, minvwt_at, g_at, bt_at, n0_at = at["WT"], at["MinvWt"], at["G"], at["bT"], at["n0"]
-    k_at, wf_at, qf_at, r_at, rho_at = at["K"], at["Wf"], at["qf"], at["r"], at["rho"]
-    best_at, newton_at = at["r_best"], at["newton"]
+    k_at, wf_at, qf_at, r_at = at["K"], at["Wf"], at["qf"], at["r"]
+    best_at, warm_at, newton_at = at["r_best"], at["r_warm"], at["newton"]
+    lt_at = at["load_transfer"]
     newton_size = newton_workspace_size(c3)
+    lt_size = load_transfer_workspace_size(c)
 
     @njit(inline="always")
     def views_of(ws):  # noqa: ANN001, ANN202
@@ -163,8 +175,9 @@ def make_spatial_step_kernels(
             array_view(fws, g_at, (c2, c2)), fws[bt_at:bt_at + c2],
             fws[n0_at:n0_at + c], array_view(fws, k_at, (c, c2)),
             array_view(fws, wf_at, (c3, c3)), fws[qf_at:qf_at + c3],
-            fws[r_at:r_at + c3], fws[rho_at:rho_at + c], fws[best_at:best_at + c3],
-            fws[newton_at:newton_at + newton_size], iws[1:1 + c],
+            fws[r_at:r_at + c3], fws[best_at:best_at + c3],
+            fws[warm_at:warm_at + c3], fws[newton_at:newton_at + newton_size],
+            fws[lt_at:lt_at + lt_size], iws[1:1 + c],
         )
 
     @borrowing_njit
@@ -174,8 +187,8 @@ def make_spatial_step_kernels(
         It carves its arrays from ``ws`` itself: passing them would flatten twenty views into
         some two hundred call arguments per step.
         """
-        (fws, mass_ready, qm, Minv, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, rho,
-         r_best, nws, sliding) = views_of(ws)
+        (fws, mass_ready, qm, Minv, ufree, Wc, mu, WT, MinvWt, G, bT, n0, K, Wf, qf, r, r_best,
+         r_warm, nws, lws, sliding) = views_of(ws)
 
         # The warm start, read before the impulses are overwritten.
         warm_load = 0.0
@@ -249,61 +262,33 @@ def make_spatial_step_kernels(
             p0 = dt
         v0 = scale * p0
 
-        # The scaled FC3D problem u' = Wf r' + qf, r' = r / p0, u' = u / (s p0).
-        for i in range(c):
-            ni = 3 * i
-            for j in range(c):
-                nj = 3 * j
-                Wf[ni, nj] = 1.0 if i == j else 0.0
-                for a in range(2):
-                    Wf[ni, nj + 1 + a] = -K[i, 2 * j + a]
-                    Wf[ni + 1 + a, nj] = 0.0
-                    for b in range(2):
-                        Wf[ni + 1 + a, nj + 1 + b] = G[2 * i + a, 2 * j + b] / scale
-            qf[ni] = -n0[i] * dt / p0
-            qf[ni + 1] = bT[2 * i] / v0
-            qf[ni + 2] = bT[2 * i + 1] / v0
-        for i in range(c):
-            ni = 3 * i
-            acc = 0.0
-            for a in range(3):
-                for b in range(3):
-                    acc += Wf[ni + a, ni + b] * Wf[ni + a, ni + b]
-            rho[i] = 1.0 / np.sqrt(acc)
-        # The solver's residual is relative to max(|qf|, 1): ask for NEWTON_TOL absolute, that
-        # is in units of the weight impulse, whatever the speed (floored above round-off).
+        # The problem in units of P0 and s P0 (r' = r / p0, u' = u / (s p0)): G, b_T and the
+        # static loads N0 dt scaled in place.
         q_norm = 0.0
-        for i in range(c3):
-            q_norm += qf[i] * qf[i]
+        inv_scale = 1.0 / scale
+        inv_v0 = 1.0 / v0
+        load_unit = dt / p0
+        for r_ in range(c2):
+            bT[r_] *= inv_v0
+            q_norm += bT[r_] * bT[r_]
+            for s in range(c2):
+                G[r_, s] *= inv_scale
+        for i in range(c):
+            n0[i] *= load_unit
+            q_norm += n0[i] * n0[i]
+        # The solver's residual is relative to max(|q|, 1): ask for NEWTON_TOL absolute, that
+        # is in units of the weight impulse, whatever the speed (floored above round-off).
         tol = max(NEWTON_TOL / max(np.sqrt(q_norm), 1.0), NEWTON_TOL_FLOOR)
-        # Starts, until one converges: the previous impulses (warm), the static loads without
-        # friction, zero. Keep the best result (by residual) if none does.
-        attempt = 0 if warm_load > 0.0 else 1
-        code = CODE_BREAKDOWN
-        iterations = 0
-        residual = np.inf
-        best = np.inf
-        while attempt <= 2:
-            if attempt == 0:
-                for i in range(c3):
-                    r[i] /= p0
-            else:
-                _static_start(n0, dt / p0 if attempt == 1 else 0.0, r)
-            code, steps, residual = newton_ac_core(
-                Wf, qf, mu, rho, r, NEWTON_MAX_ITER, tol, 1e-4, 40, 1.0, nws
-            )
+        for i in range(c3):
+            r_warm[i] = r[i] / p0 if warm_load > 0.0 else 0.0
+            r[i] = r_warm[i]
+        # First Newton on the friction impulses alone, the loads solved in closed form.
+        code, iterations, residual = newton_load_transfer(
+            G, bT, n0, K, mu, r, LOAD_TRANSFER_MAX_ITER, tol, 1e-4, 40, lws)
+        if code != CODE_CONVERGED:  # then the full FC3D problem
+            code, steps, residual = _solve_full_problem(
+                G, bT, n0, K, mu, r, r_warm, warm_load > 0.0, tol, Wf, qf, r_best, nws)
             iterations += steps
-            if code == CODE_CONVERGED:
-                break
-            if residual < best:
-                best = residual
-                for i in range(c3):
-                    r_best[i] = r[i]
-            attempt += 1
-        if code != CODE_CONVERGED and best < np.inf:
-            residual = best
-            for i in range(c3):
-                r[i] = r_best[i]
         if code == CODE_CONVERGED and motion == MOTION_UNDER_RESOLVED:
             code = CODE_INACCURATE
         info[INFO_STATUS] = code
@@ -401,12 +386,66 @@ def make_spatial_step_kernels(
 
 
 @njit(cache=True, **REFERENCE_COUNTED)
-def _static_start(n0, scale, r):  # noqa: ANN001
-    """Set r to the static loads N0 * scale (clipped at 0) with no friction (scale 0: r = 0)."""
-    for i in range(n0.shape[0]):
-        r[3 * i] = max(n0[i] * scale, 0.0)
-        r[3 * i + 1] = 0.0
-        r[3 * i + 2] = 0.0
+def _solve_full_problem(G, b, n0, K, mu, r, r_warm, warm, tol, Wf, qf, r_best,  # noqa: ANN001
+                        newton_workspace) -> tuple[int, int, float]:
+    """The scaled FC3D problem ``u' = Wf r' + qf`` by ``newton_ac_core``, from several starts.
+
+    The fallback when ``newton_load_transfer`` does not converge. Starts, until one converges:
+    r_warm (if ``warm``), the static loads without friction, zero; the best result (by
+    residual) is kept if none does.
+
+    Args:
+        G: (2c, 2c), b: (2c,), n0: (c,), K: (c, 2c), mu: (c,): the problem as
+            ``newton_load_transfer`` takes it (scaled). r: (3c,) output. r_warm: (3c,).
+        warm: whether to start from r_warm. tol: shared-residual tolerance.
+        Wf, qf, r_best: (3c, 3c), (3c,), (3c,) scratch.
+        newton_workspace: ``newton_ac_core``'s scratch.
+
+    Returns:
+        (code, Newton steps over all starts, residual).
+    """
+    c = mu.shape[0]
+    for i in range(c):
+        ni = 3 * i
+        for j in range(c):
+            nj = 3 * j
+            Wf[ni, nj] = 1.0 if i == j else 0.0
+            for a in range(2):
+                Wf[ni, nj + 1 + a] = -K[i, 2 * j + a]
+                Wf[ni + 1 + a, nj] = 0.0
+                for s in range(2):
+                    Wf[ni + 1 + a, nj + 1 + s] = G[2 * i + a, 2 * j + s]
+        qf[ni] = -n0[i]
+        qf[ni + 1] = b[2 * i]
+        qf[ni + 2] = b[2 * i + 1]
+    rho = contact_weights(Wf, 1.0)
+    attempt = 0 if warm else 1
+    code = CODE_BREAKDOWN
+    iterations = 0
+    residual = np.inf
+    best = np.inf
+    while attempt <= 2:
+        for i in range(c):
+            load = max(n0[i], 0.0) if attempt == 1 else 0.0
+            r[3 * i] = r_warm[3 * i] if attempt == 0 else load
+            r[3 * i + 1] = r_warm[3 * i + 1] if attempt == 0 else 0.0
+            r[3 * i + 2] = r_warm[3 * i + 2] if attempt == 0 else 0.0
+        code, steps, residual = newton_ac_core(
+            Wf, qf, mu, rho, r, NEWTON_MAX_ITER, tol, 1e-4, 40, 1.0, newton_workspace
+        )
+        iterations += steps
+        if code == CODE_CONVERGED:
+            return code, iterations, residual
+        if residual < best:
+            best = residual
+            for i in range(3 * c):
+                r_best[i] = r[i]
+        attempt += 1
+    if best < np.inf:
+        residual = best
+        for i in range(3 * c):
+            r[i] = r_best[i]
+    return code, iterations, residual
 
 
 __all__ = [

@@ -133,6 +133,19 @@ def contact_weights(W: FloatArray, rho_scale: float) -> FloatArray:
 
 
 @njit(cache=True, inline="always")
+def slide_direction(a1: float, a2: float, norm: float, radius: float
+                    ) -> tuple[float, float, float]:
+    """(n1, n2, s): n = a / |a| and s = radius / |a| for a = (a1, a2), norm = |a| (0 for a = 0).
+
+    Outside the disk of that radius its projection is ``radius n``, with derivative
+    ``s (I - n n^T)`` in a.
+    """
+    if norm > 0.0:
+        return a1 / norm, a2 / norm, radius / norm
+    return 0.0, 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
 def _alart_curnier_at(
     rho: float,
     mu: float,
@@ -176,14 +189,7 @@ def _alart_curnier_at(
             B[i, 2, 2] = rho
         return
     # slide (or no normal impulse): phi_T = r_T - R n, n = a_T / |a_T|
-    if norm_t > 0.0:
-        n1 = a_t1 / norm_t
-        n2 = a_t2 / norm_t
-        s = radius / norm_t
-    else:
-        n1 = 0.0
-        n2 = 0.0
-        s = 0.0
+    n1, n2, s = slide_direction(a_t1, a_t2, norm_t, radius)
     phi[k + 1] = r[k + 1] - radius * n1
     phi[k + 2] = r[k + 2] - radius * n2
     if not with_jacobian:
@@ -558,6 +564,7 @@ __all__ = [
     "make_workspace",
     "newton_ac_core",
     "newton_ac_kernel",
+    "slide_direction",
     "solve_newton_ac",
     "workspace_size",
 ]

@@ -133,11 +133,10 @@ def cone_projection(mu: float, x_n: float, x_t1: float, x_t2: float) -> tuple[fl
 
 @njit(cache=True, inline="always")
 def compute_velocity(W: FloatArray, q: FloatArray, r: FloatArray, u: FloatArray) -> None:
-    """Fill u (n,) with W r + q, for W (n, n), q (n,), r (n,)."""
-    n = q.shape[0]
-    for i in range(n):
+    """Fill u (m,) with W r + q, for W (m, n), q (m,), r (n,)."""
+    for i in range(q.shape[0]):
         acc = q[i]
-        for j in range(n):
+        for j in range(r.shape[0]):
             acc += W[i, j] * r[j]
         u[i] = acc
 
