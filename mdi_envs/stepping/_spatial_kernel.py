@@ -238,11 +238,12 @@ def make_spatial_step_kernels(
             for j in range(n):
                 acc += WT[r_, j] * ufree[j]
             bT[r_] = acc
-            for s in range(c2):
+            for s in range(r_, c2):  # G is symmetric (M is): its upper triangle, mirrored
                 acc = 0.0
                 for j in range(n):
                     acc += WT[r_, j] * MinvWt[j, s]
                 G[r_, s] = acc
+                G[s, r_] = acc
             trace += G[r_, r_]
         scale = trace / c2
         if not scale > 0.0:

@@ -50,11 +50,11 @@ _CONSISTENCY_TOL = 1e-10
 def load_transfer_workspace_size(nc: int) -> int:
     """Length of the flat scratch buffer of ``newton_load_transfer`` for nc contacts."""
     m = 2 * nc
-    return _NUM_VECTORS * m + 3 * nc + 6 * nc + 2 * m * m
+    return _NUM_VECTORS * m + 3 * nc + 6 * nc + m * m
 
 
 _NUM_VECTORS = 8
-"""Length-2 nc scratch vectors (then three of length nc, two of 3 nc and two matrices)."""
+"""Length-2 nc scratch vectors (then three of length nc, two of 3 nc and the Jacobian)."""
 
 
 @njit(cache=True, inline="always")
@@ -76,8 +76,7 @@ def _workspace_in(buffer: FloatArray, nc: int) -> tuple[FloatArray, ...]:
         buffer[at + 2 * nc:at + 3 * nc],  # trial loads
         buffer[at + 3 * nc:at + 6 * nc],  # q of the full problem
         buffer[at + 6 * nc:at + 9 * nc],  # u of the full problem
-        array_view(buffer, at + 9 * nc, (m, m)),  # J
-        array_view(buffer, at + 9 * nc + m * m, (m, m)),  # factored J
+        array_view(buffer, at + 9 * nc, (m, m)),  # J, then its factors
     )
 
 
@@ -176,8 +175,8 @@ def newton_load_transfer(
     """
     nc = mu.shape[0]
     m = 2 * nc
-    (t, v, phi, d, swaps, trial_t, trial_v, trial_phi, rho, loads, trial_loads, q, u, J,
-     H) = _workspace_in(workspace, nc)
+    (t, v, phi, d, swaps, trial_t, trial_v, trial_phi, rho, loads, trial_loads, q, u,
+     J) = _workspace_in(workspace, nc)
     for i in range(nc):
         k = 2 * i
         acc = G[k, k] * G[k, k] + G[k, k + 1] * G[k, k + 1]
@@ -201,10 +200,8 @@ def newton_load_transfer(
             break
         psi = _tangential_ac(mu, rho, G, K, t, v, loads, phi, J, True)
         for i in range(m):
-            for j in range(m):
-                H[i, j] = J[i, j]
             d[i] = -phi[i]
-        solved = solve_consistent_inplace(H, d, swaps, _PIVOT_TOL, _CONSISTENCY_TOL)
+        solved = solve_consistent_inplace(J, d, swaps, _PIVOT_TOL, _CONSISTENCY_TOL)
         for i in range(m):
             if not np.isfinite(d[i]):
                 solved = False
