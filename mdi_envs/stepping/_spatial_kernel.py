@@ -127,12 +127,15 @@ def make_spatial_workspace(model: type[ModelDefinition]) -> tuple[np.ndarray, np
 
 
 def make_spatial_step_kernels(
-    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts
+    model: type[ModelDefinition], eq: CompiledEquations, shortcuts: StepShortcuts,
+    load_transfer_max_iter: int = LOAD_TRANSFER_MAX_ITER,
 ) -> tuple[Any, Any]:
     """Compile ``step(...)`` and ``step_batch(...)`` for a spatial ``model``.
 
     The kernels have the planar kernels' signatures (``mdi_envs.stepping._kernel``) and write
-    ``SPATIAL_INFO_SIZE`` diagnostics.
+    ``SPATIAL_INFO_SIZE`` diagnostics. ``load_transfer_max_iter`` bounds the Newton steps on
+    the friction impulses alone before the full FC3D problem is solved (0: always the full
+    problem unless the warm start solves it; tests compare both paths).
 
     Raises:
         NotImplementedError: the model is not spatial, has brakes, or lacks ``normal_loads``.
@@ -285,7 +288,7 @@ def make_spatial_step_kernels(
             r[i] = r_warm[i]
         # First Newton on the friction impulses alone, the loads solved in closed form.
         code, iterations, residual = newton_load_transfer(
-            G, bT, n0, K, mu, r, LOAD_TRANSFER_MAX_ITER, tol, 1e-4, 40, lws)
+            G, bT, n0, K, mu, r, load_transfer_max_iter, tol, 1e-4, 40, lws)
         if code != CODE_CONVERGED:  # then the full FC3D problem
             code, steps, residual = _solve_full_problem(
                 G, bT, n0, K, mu, r, r_warm, warm_load > 0.0, tol, Wf, qf, r_best, nws)

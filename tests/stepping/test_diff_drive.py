@@ -329,3 +329,45 @@ def test_bad_input_raises(make: Callable[..., MoreauJeanStepper]) -> None:
         stepper.step_batch(np.zeros((2, 4)), u, np.zeros((2, 2)))
     with pytest.raises(ValueError):
         stepper.step_batch(q, u, np.zeros((2, 2)), num_substeps=0)
+
+
+def test_the_full_fc3d_fallback_steps_as_the_newton_on_friction_impulses() -> None:
+    """The full FC3D fallback gives the trajectory of the Newton on friction impulses alone.
+
+    With no Newton step allowed on the friction impulses, every solve that the warm start does
+    not already satisfy goes to the full FC3D problem (``newton_ac_core``): the trajectory
+    through rolling, turning, wheel spin and braking is the same to the solvers' tolerance,
+    and both report the same modes.
+    """
+    from mdi_envs.mechanics.compiled import compile_equations
+    from mdi_envs.stepping import _spatial_kernel
+    from mdi_envs.stepping._kernel import INFO_ITERATIONS, StepShortcuts
+
+    stepper = MoreauJeanStepper(DiffDriveRobot, time_step=DT)
+    _, record, _ = stepper.compiled_step_batch
+    default_step = stepper.compiled_step
+    fallback_step, _ = _spatial_kernel.make_spatial_step_kernels(
+        DiffDriveRobot, compile_equations(DiffDriveRobot), StepShortcuts(),
+        load_transfer_max_iter=0)
+    runs = {}
+    for name, step in (("default", default_step), ("fallback", fallback_step)):
+        q, u = np.zeros(5), np.zeros(5)
+        q_next, u_next = np.empty(5), np.empty(5)
+        impulses, info = np.zeros(9), np.zeros(SPATIAL_INFO_SIZE)
+        workspace = _spatial_kernel.make_spatial_workspace(DiffDriveRobot)
+        states, modes, iterations = [], [], 0
+        for k in range(400):
+            tau = [(0.5, 0.5), (0.2, 0.8), (5.0, 5.0), (-2.0, -2.0)][k // 100]
+            step(q, u, np.array(tau), np.zeros(0), DT, record, q_next, u_next, impulses, info,
+                 workspace)
+            assert info[INFO_STATUS] == 0.0
+            q, u = q_next.copy(), u_next.copy()
+            states.append(np.concatenate([q, u]))
+            modes.append(info[INFO_MODE])
+            iterations += info[INFO_ITERATIONS]
+        runs[name] = (np.array(states), modes, iterations)
+    np.testing.assert_allclose(runs["fallback"][0], runs["default"][0], rtol=0, atol=1e-9)
+    assert not np.array_equal(runs["fallback"][0], runs["default"][0])  # two solvers did run
+    assert runs["fallback"][1] == runs["default"][1]
+    assert set(runs["default"][1]) >= {2.0, 5.0}  # rolling and spinning wheels both seen
+    assert runs["default"][2] > 0 and runs["fallback"][2] > 0
