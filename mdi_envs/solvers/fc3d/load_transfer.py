@@ -14,7 +14,8 @@ the problem reduces to a nonsmooth equation in t alone (2 nc unknowns, not 3 nc)
 
     phi_i(t) = t_i - P_D(R_i)(t_i - rho_i (G t + b)_i),   R_i = mu_i max(0, n0_i + K_i . t),
 
-the tangential rows of the Alart-Curnier function (``newton_ac``) with the normal rows solved.
+the tangential rows of the Alart-Curnier function (``newton_ac``) with the normal rows solved,
+with the weight rho_i = 1 / ||G_ii||_F (contact i's 2 x 2 diagonal block).
 phi = 0 exactly at the FC3D solutions. ``newton_load_transfer`` solves it by semismooth Newton
 with an Armijo line search on |phi|^2 / 2; the Newton systems are solved by
 ``solve_consistent_inplace`` (two wheels on one axle give duplicated lateral rows). It has no
@@ -46,15 +47,15 @@ _CONSISTENCY_TOL = 1e-10
 """A singular Newton system counts as consistent below this fraction of |phi| (as newton_ac)."""
 
 
+_NUM_VECTORS = 8
+"""Length-2 nc scratch vectors (then three of length nc, two of 3 nc and the Jacobian)."""
+
+
 @njit(cache=True)
 def load_transfer_workspace_size(nc: int) -> int:
     """Length of the flat scratch buffer of ``newton_load_transfer`` for nc contacts."""
     m = 2 * nc
     return _NUM_VECTORS * m + 3 * nc + 6 * nc + m * m
-
-
-_NUM_VECTORS = 8
-"""Length-2 nc scratch vectors (then three of length nc, two of 3 nc and the Jacobian)."""
 
 
 @njit(cache=True, inline="always")
