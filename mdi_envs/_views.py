@@ -4,9 +4,9 @@ The compiled steps keep their scratch arrays in one flat float64 buffer (a singl
 cheap to pass from Python) and carve their matrices from it on every call. numba's
 ``buffer[a:b].reshape(shape)`` goes through a generic C helper that re-derives the strides and
 checks contiguity on every call (it showed in perf of the robot's step, eleven views per call).
-``array_view``
-builds the same view from the buffer's data pointer and stride directly (a few integer
-operations). The view shares the buffer's memory and its reference count, as a slice does.
+``array_view`` builds the same view from the buffer's data pointer and stride directly (a few
+integer operations). The view shares the buffer's memory and its reference count, as a slice
+does.
 
 It does not check bounds: ``start`` and ``shape`` must lie inside the buffer. Callers carve
 compile-time layouts from buffers sized by those same layouts (``offsets_of``).

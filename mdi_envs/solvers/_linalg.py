@@ -45,6 +45,16 @@ def _eliminate_below(A: FloatArray, b: FloatArray, k: int, p: int) -> None:
             b[i] -= f * b[k]
 
 
+@njit(cache=True, inline="always")
+def _back_substitute(A: FloatArray, b: FloatArray, rank: int) -> None:
+    """b[:rank] = U^-1 b[:rank], U the upper triangle of A's leading rank x rank block."""
+    for i in range(rank - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, rank):
+            s -= A[i, j] * b[j]
+        b[i] = s / A[i, i]
+
+
 @njit(cache=True, **REFERENCE_COUNTED)
 def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool:
     """Solve ``A x = b`` by Gaussian elimination with partial pivoting, in place.
@@ -74,11 +84,7 @@ def lu_solve_inplace(A: FloatArray, b: FloatArray, rel_pivot_tol: float) -> bool
         if best <= threshold:
             return False
         _eliminate_below(A, b, k, p)
-    for i in range(n - 1, -1, -1):
-        s = b[i]
-        for j in range(i + 1, n):
-            s -= A[i, j] * b[j]
-        b[i] = s / A[i, i]
+    _back_substitute(A, b, n)
     return True
 
 
@@ -137,11 +143,7 @@ def solve_consistent_inplace(A: FloatArray, b: FloatArray, swaps: FloatArray,
         if abs(b[i]) > rel_consistency_tol * b_scale:
             return False
         b[i] = 0.0  # the free unknowns
-    for i in range(rank - 1, -1, -1):  # the pivoted unknowns, in the swapped column order
-        s = b[i]
-        for j in range(i + 1, rank):
-            s -= A[i, j] * b[j]
-        b[i] = s / A[i, i]
+    _back_substitute(A, b, rank)  # the pivoted unknowns, in the swapped column order
     for j in range(rank, n):  # undo the deferrals, the last one made first
         c = int(swaps[j])
         b[j], b[c] = b[c], b[j]
