@@ -5,7 +5,11 @@ Moreau-Jean stepper) and ``envs`` (Gymnasium environments). Importing the packag
 ``mdi_envs/...`` environment ids, so ``gym.make("mdi_envs/BlockableManipulator-v0")`` works.
 """
 
-from mdi_envs.registration import ENV_IDS, register_envs
+from mdi_envs import _kernel_cache
+
+_kernel_cache.install_locator()  # before any cached kernel is defined: see _kernel_cache
+
+from mdi_envs.registration import ENV_IDS, register_envs  # noqa: E402
 
 __version__ = "0.1.0"
 

@@ -36,6 +36,7 @@ from gymnasium.vector.utils import batch_space
 from numba import njit
 
 from mdi_envs._borrowing import borrowing_njit
+from mdi_envs._kernel_cache import define, freeze
 from mdi_envs._types import BoolArray, FloatArray
 from mdi_envs.envs._actions import ARRAY_DTYPE_CHARS, TorqueBrakeActions, decode_levels
 from mdi_envs.mechanics.models.base import ModelDefinition
@@ -663,7 +664,7 @@ def _state_carver(layout: StateLayout) -> tuple[tuple[str, ...], Any, Any]:
                  "obs", "settings")
         lines.append(f"    return ({', '.join(names)},)")
         namespace: dict[str, Any] = {"np": np}
-        exec("\n".join(lines), namespace)  # noqa: S102 - generated from the layout's widths
+        define("\n".join(lines), namespace)
         carve = namespace["carve"]
         _CARVERS[layout] = (names, carve, njit(inline="always")(carve))
     return _CARVERS[layout]
@@ -715,8 +716,7 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
         return _COMPILED[key]
     record_entries = ", ".join(f"settings[{SETTINGS_SIZE + i}]" for i in range(len(record)))
     namespace: dict[str, Any] = {"Record": type(record)}
-    exec(f"def read_record(settings):\n    return Record({record_entries})",  # noqa: S102
-         namespace)  # fmt: skip
+    define(f"def read_record(settings):\n    return Record({record_entries})", namespace)
     read_record = njit(inline="always")(namespace["read_record"])
     carve_state = _state_carver(layout)[2]
     constants_start = SETTINGS_SIZE + len(record)
@@ -816,7 +816,11 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
             potential[i] = -shaping_weight * distance_one(q[i], u[i], c)
             observe_one(q[i], u[i], brake[i], horizon * dt, c, obs[i])
 
-    _COMPILED[key] = (advance, observe_all, distance_one, restart)
+    frozen = freeze(f"task_{type(task).__name__}",
+                    {"advance": advance, "observe_all": observe_all,
+                     "distance_one": distance_one, "restart": restart})
+    _COMPILED[key] = (frozen["advance"], frozen["observe_all"], frozen["distance_one"],
+                      frozen["restart"])
     return _COMPILED[key]
 
 

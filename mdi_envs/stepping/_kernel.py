@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from mdi_envs._borrowing import REFERENCE_COUNTED, borrowing_njit
+from mdi_envs._kernel_cache import define
 from mdi_envs._views import array_view
 from mdi_envs.mechanics.compiled import CompiledEquations
 from mdi_envs.mechanics.models.base import ModelDefinition
@@ -146,7 +147,7 @@ def _make_carver(layout: Layout) -> Any:
         lines.append(f"    {name} = array_view(buffer, {offset}, {shape!r})")
     lines.append(f"    return ({', '.join(layout)},)")
     namespace: dict[str, Any] = {"array_view": array_view}
-    exec("\n".join(lines), namespace)  # noqa: S102 - generated from the layout's constants
+    define("\n".join(lines), namespace)
     return njit(namespace["carve"])
 
 

@@ -19,6 +19,7 @@ from typing import Any
 
 from numba import njit
 
+from mdi_envs._kernel_cache import define
 from mdi_envs._views import array_view
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.solvers._linalg import invert_into
@@ -230,7 +231,7 @@ def make_free_motion(model: type[ModelDefinition], reuse_constant_mass: bool) ->
         "RESOLVED_INERTIA_FRACTION": RESOLVED_INERTIA_FRACTION,
         "SINGULAR_PIVOT": SINGULAR_PIVOT,
     }
-    exec(source, namespace)  # noqa: S102 - generated from the model's sizes and flags
+    define(source, namespace)
     return njit(inline="always", error_model="numpy")(namespace["free_motion"])
 
 
@@ -266,7 +267,7 @@ def make_midpoint_rows(model: type[ModelDefinition],
         "friction_coefficients": njit(model.friction_coefficients),
         "brake_rows": njit(model.brake_directions),
     }
-    exec("\n".join(lines), namespace)  # noqa: S102 - generated from the model's sizes
+    define("\n".join(lines), namespace)
     return njit(inline="always")(namespace["midpoint_rows"])
 
 

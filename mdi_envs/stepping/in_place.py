@@ -22,6 +22,7 @@ import numba
 import numpy as np
 
 from mdi_envs._borrowing import borrowing_njit
+from mdi_envs._kernel_cache import define, freeze
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers.status import SolverStatus
 from mdi_envs.stepping._kernel import INFO_STATUS
@@ -74,7 +75,7 @@ def _make_kernel(stepper: MoreauJeanStepper) -> Any:
     ]
     namespace: dict[str, Any] = {"Record": type(record), "step": stepper.compiled_step,
                                  "screen": _screen_inputs, "np": np}
-    exec("\n".join(lines), namespace)  # noqa: S102 - generated from the model's sizes
+    define("\n".join(lines), namespace)
     return borrowing_njit(namespace["step_in_place"])
 
 
@@ -106,7 +107,8 @@ class InPlaceStepper:
         record = stepper.compiled_step_batch[1]
         key = (stepper.compiled_step, type(record))
         if key not in _KERNELS:
-            _KERNELS[key] = _make_kernel(stepper)
+            _KERNELS[key] = freeze(f"in_place_{stepper.model.__name__}",
+                                   {"step_in_place": _make_kernel(stepper)})["step_in_place"]
         layout = _buffer_layout(stepper)
         self._buffer = np.zeros(len(record) + 1 + sum(size for _, size in layout))
         self._buffer[: len(record)] = record

@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit
 
 from mdi_envs._borrowing import REFERENCE_COUNTED
+from mdi_envs._kernel_cache import freeze
 from mdi_envs._types import FloatArray
 from mdi_envs.mechanics.compiled import compile_equations
 from mdi_envs.mechanics.models.base import ModelDefinition
@@ -138,11 +139,14 @@ class MoreauJeanStepper:
             )
         if key not in _KERNELS:
             equations = compile_equations(self.model)
-            _KERNELS[key] = (
+            step, step_batch = (
                 make_spatial_step_kernels(self.model, equations, self.shortcuts) if spatial
                 else make_step_kernels(self.model, equations, self.shortcuts,
                                        self.locate_impacts)
             )  # fmt: skip
+            frozen = freeze(f"step_{self.model.__name__}",
+                            {"step": step, "step_batch": step_batch})
+            _KERNELS[key] = (frozen["step"], frozen["step_batch"])
         self._step, self._step_batch = _KERNELS[key]
         if spatial:
             self._workspace = make_spatial_workspace(self.model)
