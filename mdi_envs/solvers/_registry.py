@@ -80,6 +80,9 @@ class MethodSpec(Generic[OptionsT]):
     solve: Callable[..., Any]
     options_type: type[OptionsT]
     summary: str
+    direct: Callable[..., Any] | None = None
+    """Optional whole-driver path of the method, for drivers that offer one: screening, trivial
+    cases, the method and the shared residual check in one compiled call (see ``solve_lcp``)."""
 
     def make_options(self, overrides: dict[str, Any]) -> OptionsT:
         """Build this method's options from keyword overrides.
@@ -113,14 +116,21 @@ class MethodRegistry:
         self._methods: dict[str, MethodSpec[Any]] = {}
 
     def register(
-        self, name: str, options_type: type[SolverOptions], summary: str
+        self,
+        name: str,
+        options_type: type[SolverOptions],
+        summary: str,
+        direct: Callable[..., Any] | None = None,
     ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-        """Decorator registering ``solve`` under ``name`` with its options type and summary."""
+        """Decorator registering ``solve`` under ``name`` with its options type and summary.
+
+        ``direct``, if given, is the method's whole-driver path (see ``MethodSpec.direct``).
+        """
 
         def decorator(solve: Callable[..., Any]) -> Callable[..., Any]:
             if name in self._methods:
                 raise ValueError(f"{self.problem_name} method {name!r} registered twice")
-            self._methods[name] = MethodSpec(name, solve, options_type, summary)
+            self._methods[name] = MethodSpec(name, solve, options_type, summary, direct)
             return solve
 
         return decorator
