@@ -199,7 +199,9 @@ def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     sets = {
         "Siconos peer files": [r for r in rows if r["family"] == "siconos"],
         "random (spd + contact)": [r for r in rows if r["family"] != "siconos"],
-        "random spd": [r for r in rows if r["family"] == "spd"],
+        "random spd (the issue-23 target: driver / QE <= 1)": [
+            r for r in rows if r["family"] == "spd"
+        ],
         "random contact": [r for r in rows if r["family"] == "contact"],
         "Siconos peer files solved by all three": [r for r in solved if r["family"] == "siconos"],
     }
@@ -231,6 +233,22 @@ def ratio_table(summary: Sequence[dict[str, Any]]) -> str:
             format_ratio(s["median_ratio_kernel"]),
         ]
         for s in summary
+    ]
+    return markdown_table(header, body)
+
+
+def fixed_cost_table(rows: Sequence[dict[str, Any]]) -> str:
+    """Markdown table of the n = 2 fixed-cost rows: median µs per call of each entry."""
+    header = ["problem", "solve_lcp (driver) µs", "lemke_solve µs", "QuantEcon µs", "driver/QE"]
+    body = [
+        [
+            row["name"],
+            format_us(row["driver"]["time"]["median_s"]),
+            format_us(row["kernel"]["time"]["median_s"]),
+            format_us(row["quantecon"]["time"]["median_s"]),
+            format_ratio(row["driver"]["time"]["median_s"] / row["quantecon"]["time"]["median_s"]),
+        ]
+        for row in rows
     ]
     return markdown_table(header, body)
 

@@ -8,6 +8,11 @@ Usage (from the repository root; ``mdi-envs bench solvers`` runs it into benchma
 Writes ``solvers.json``, ``solvers_time_vs_size.png``, ``solvers_residual_vs_size.png`` and
 ``lemke_vs_quantecon.png`` to the output folder, prints progress lines on stderr and the
 Markdown results tables (the ones in ``benchmarks/README.md``) on stdout.
+
+The QuantEcon comparison times three entries interleaved on each problem: the public driver
+``solve_lcp(M, q, method="lemke")`` (input checks and residual check included), our compiled
+entry ``lemke_solve`` (neither) and QuantEcon's ``lcp_lemke``; the fixed cost of each is measured
+on two 2 x 2 problems (one needing two pivots, one with q >= 0 solved by z = 0).
 """
 
 from __future__ import annotations
@@ -17,6 +22,8 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from benchmarks import entries as E
 from benchmarks import report
@@ -48,7 +55,8 @@ class BenchConfig:
         instances: random instances per (family, n) in the work-size study.
         size_plan: timing plan per problem of the work-size study.
         peer_sizes: n of the random problems of the QuantEcon comparison.
-        peer_plan: timing plan per problem of the QuantEcon comparison.
+        peer_instances: random instances per (family, n) in the QuantEcon comparison.
+        peer_plan: timing plan per problem of the QuantEcon comparison (and the fixed cost).
         cold_compile: also measure first calls with an empty numba cache (about 30 s).
     """
 
@@ -56,6 +64,7 @@ class BenchConfig:
     instances: int
     size_plan: TimingPlan
     peer_sizes: tuple[int, ...]
+    peer_instances: int
     peer_plan: TimingPlan
     cold_compile: bool
 
@@ -65,6 +74,7 @@ FULL = BenchConfig(
     instances=5,
     size_plan=TimingPlan(budget_s=0.05, min_rounds=5, max_rounds=100),
     peer_sizes=tuple(range(10, 101, 10)),
+    peer_instances=2,
     peer_plan=TimingPlan(budget_s=0.25, min_rounds=9, max_rounds=400),
     cold_compile=True,
 )
@@ -73,6 +83,7 @@ QUICK = BenchConfig(
     instances=2,
     size_plan=TimingPlan(budget_s=0.005, min_rounds=3, max_rounds=20),
     peer_sizes=(10, 50, 100),
+    peer_instances=1,
     peer_plan=TimingPlan(budget_s=0.02, min_rounds=3, max_rounds=30),
     cold_compile=False,
 )
@@ -149,8 +160,40 @@ def comparison_problems(config: BenchConfig, log: Progress) -> list[Problem]:
             f"peer data: {peer_data_dir() / 'lcp'} absent; skipping the Siconos files "
             "(set MDI_ENVS_PEER_DATA to the siconos folder to include them)"
         )
-    randoms = [random_problem(f, n, 0) for f in FAMILIES for n in config.peer_sizes]
+    randoms = [
+        random_problem(f, n, i)
+        for f in FAMILIES
+        for n in config.peer_sizes
+        for i in range(config.peer_instances)
+    ]
     return peers + randoms
+
+
+FIXED_COST_PROBLEMS = (
+    Problem("2x2, two pivots", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
+            np.array([-5.0, -6.0])),
+    Problem("2x2, q >= 0", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
+            np.array([1.0, 2.0])),
+)
+"""n = 2 problems on which a call's time is almost all fixed cost (dispatch, checks, result)."""
+
+
+def measure_fixed_cost(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
+    """Time per call of the three Lemke entries on the n = 2 problems (interleaved)."""
+    keys = {"driver": E.DRIVER_LEMKE, "kernel": E.KERNEL, "quantecon": E.QUANTECON}
+    rows = []
+    for problem in FIXED_COST_PROBLEMS:
+        measured = time_problem(problem, list(keys.values()), config.peer_plan)
+        row: dict[str, Any] = {"name": problem.name, "n": problem.n}
+        row.update({key: measured[entry.name] for key, entry in keys.items()})
+        rows.append(row)
+        log(
+            f"fixed cost {problem.name}: "
+            + ", ".join(
+                f"{key} {report.format_us(row[key]['time']['median_s'])} µs" for key in keys
+            )
+        )
+    return rows
 
 
 def compare_with_quantecon(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
@@ -201,6 +244,10 @@ def markdown_report(
         "**Median time ratio ours / QuantEcon** (< 1: ours faster)",
         "",
         report.ratio_table(summary),
+        "",
+        "**Fixed cost per call at n = 2** (median µs per call, interleaved rounds)",
+        "",
+        report.fixed_cost_table(record["fixed_cost"]),
     ]
     return "\n".join(lines)
 
@@ -234,6 +281,7 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
     log(f"LCP solver benchmark ({'quick' if quick else 'full'}) -> {output}")
     record["first_call"] = measure_first_calls(config, log)
     warm_up([E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)])
+    record["fixed_cost"] = measure_fixed_cost(config, log)
     records = size_study(config, log)
     aggregates = report.aggregate_size_study(records)
     record["size_study"] = {"records": records, "aggregates": aggregates}
