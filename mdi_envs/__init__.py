@@ -6,12 +6,11 @@ Moreau-Jean stepper) and ``envs`` (Gymnasium environments). Importing the packag
 """
 
 from mdi_envs import _kernel_cache
+from mdi_envs._version import __version__
 
 _kernel_cache.install_locator()  # before any cached kernel is defined: see _kernel_cache
 
 from mdi_envs.registration import ENV_IDS, register_envs  # noqa: E402
-
-__version__ = "0.1.0"
 
 register_envs()
 

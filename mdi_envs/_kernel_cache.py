@@ -55,11 +55,12 @@ import numpy as np
 from numba.core import caching, config
 from numba.core.dispatcher import Dispatcher
 
+from mdi_envs._version import __version__
+
 CACHE_DIR_VARIABLE = "MDI_ENVS_CACHE_DIR"
 """Environment variable that overrides the cache root."""
 
 PACKAGE_DIR = Path(__file__).resolve().parent
-_PACKAGE_VERSION = "0.1.0"  # kept equal to mdi_envs.__version__ by tests/test_kernel_cache.py
 
 
 def cache_root() -> Path:
@@ -73,12 +74,12 @@ def cache_root() -> Path:
     return Path(base).resolve() / "mdi_envs"
 
 
-def source_digest() -> str:
-    """Hash of this package's Python sources, its version, numba's and Python's (16 hex)."""
+def source_digest(package_dir: Path = PACKAGE_DIR) -> str:
+    """Hash of the package's Python sources, its version, numba's and Python's (16 hex)."""
     hasher = hashlib.sha256()
-    hasher.update(f"{_PACKAGE_VERSION} numba {numba.__version__} {sys.version}".encode())
-    for path in sorted(PACKAGE_DIR.rglob("*.py")):
-        hasher.update(path.relative_to(PACKAGE_DIR).as_posix().encode() + b"\0")
+    hasher.update(f"{__version__} numba {numba.__version__} {sys.version}".encode())
+    for path in sorted(package_dir.rglob("*.py")):
+        hasher.update(path.relative_to(package_dir).as_posix().encode() + b"\0")
         hasher.update(path.read_bytes() + b"\0")
     return hasher.hexdigest()[:16]
 
