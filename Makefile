@@ -1,7 +1,8 @@
 # Two entry points: `make demo` (the main job) and `make test`. Each creates .venv and installs
 # what it needs. CI sets TORCH_SPEC=torch==2.13.0 so that pip takes the local CPU wheel before
 # anything can pull the CUDA build; ordinary users leave it empty and get torch the normal way
-# when they install the `rl` extra.
+# when they install the `rl` extra. Both first compile every env kernel into the disk cache
+# (`mdi-envs compile all`), so that the processes after it start warm.
 
 PYTHON ?= python3
 VENV ?= .venv
@@ -19,10 +20,12 @@ $(VENV)/.installed-%: pyproject.toml
 	touch $@
 
 demo: $(VENV)/.installed-rl,render
+	$(BIN)/mdi-envs compile all
 	$(BIN)/mdi-envs demo --output results/demo
 	$(BIN)/mdi-envs compare all --output results/compare
 
 test: $(VENV)/.installed-test
+	$(BIN)/mdi-envs compile all
 	$(BIN)/python -m pytest -q
 	$(BIN)/mdi-envs bench --quick
 

@@ -28,6 +28,8 @@ BENCHMARKS = {
     "precision": ("benchmarks.work_precision", "error vs wall time per scene vs closed form, "
                   "the event-driven reference and MuJoCo"),
     "stress": ("benchmarks.stress", "numerical stress cases with pass/fail criteria"),
+    "startup": ("benchmarks.startup", "interpreter start to the first env step, warm and "
+                "cold kernel cache, vs Acrobot-v1 and MuJoCo; mdi-envs compile all"),
 }
 """NAME -> (module with ``main(argv)``, what it measures)."""
 

@@ -15,7 +15,8 @@ from typing import Any
 from benchmarks.report import markdown_table
 
 SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
-           ("precision", "work_precision.json"), ("stress", "stress.json"))  # fmt: skip
+           ("precision", "work_precision.json"), ("stress", "stress.json"),
+           ("startup", "startup.json"))  # fmt: skip
 """(benchmark name, result file) whose targets enter the table, in this order."""
 
 

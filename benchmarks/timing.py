@@ -141,8 +141,9 @@ def probe_first_calls(cold: bool) -> dict[str, Any]:
     """
     env = dict(os.environ)
     with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache_dir:
-        if cold:
+        if cold:  # numba's cache for other code, the package's own (mdi_envs._kernel_cache)
             env["NUMBA_CACHE_DIR"] = cache_dir
+            env["MDI_ENVS_CACHE_DIR"] = cache_dir
         process = subprocess.run(
             [sys.executable, "-m", "benchmarks.first_call"],
             cwd=Path(__file__).resolve().parents[1],

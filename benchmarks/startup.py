@@ -1,0 +1,250 @@
+"""Start-up time: from interpreter start to the first env step returned (``mdi-envs bench startup``).
+
+For every registered id and for Gymnasium's Acrobot-v1 and MuJoCo's InvertedDoublePendulum-v5,
+each case runs ``benchmarks.startup_probe`` in a fresh interpreter and takes the wall-clock time
+from just before the process is started to the moment its first step returned: through
+``gym.make`` (single), ``gym.make_vec(id, num_envs=64)`` (vector) and an SB3 ``SubprocVecEnv``
+with 2 workers (subproc). With a warm kernel cache (filled by ``mdi-envs compile all``, whose
+time on the empty cache is recorded too) and, in the full run, with an empty one (cold: every
+kernel compiled). Warm cases are repeated, interleaved, and reported by their median.
+
+Writes ``startup.json`` and ``startup.png`` into ``--output`` and prints a Markdown table.
+``--quick`` (inside ``make test``) measures the warm single and vector cases once on the
+user's cache, after ``mdi-envs compile all``. ``--python-path DIR`` runs every probe on the
+package found in DIR (e.g. a checkout of an earlier commit, to measure "before").
+Full run: about 10 min on 2 cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from benchmarks.timing import Progress, machine_info
+
+REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
+"""Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run."""
+ENTRIES = ("single", "vector", "subproc")
+TARGET_RATIO = 2.0
+"""Warm start-up target: within this factor of Acrobot-v1's, entry by entry."""
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _environment(cache: Path | None, python_path: Path | None) -> dict[str, str]:
+    environment = dict(os.environ)
+    if cache is not None:
+        environment["MDI_ENVS_CACHE_DIR"] = str(cache)
+    if python_path is not None:
+        environment["PYTHONPATH"] = str(python_path)
+    return environment
+
+
+def time_to_first_step(entry: str, env_id: str, cache: Path | None,
+                       python_path: Path | None = None) -> dict[str, Any]:
+    """Seconds from starting a fresh interpreter to its first ``step`` returned, and phases.
+
+    ``cache``: the kernel cache root (None: the user's). Returns ``{"error": ...}`` if the
+    probe failed.
+    """
+    started = time.time()
+    process = subprocess.run(
+        [sys.executable, "-m", "benchmarks.startup_probe", entry, env_id], cwd=ROOT,
+        env=_environment(cache, python_path), capture_output=True, text=True, check=False,
+    )
+    lines = [line for line in process.stdout.splitlines() if line.startswith("{")]
+    if process.returncode != 0 or not lines:
+        return {"error": (process.stderr.strip().splitlines() or ["no output"])[-1]}
+    report = json.loads(lines[-1])
+    return {"seconds": report["done"] - started, "phases": report["phases"]}
+
+
+def compile_all(cache: Path | None, python_path: Path | None = None) -> dict[str, Any]:
+    """Wall seconds of ``mdi-envs compile all`` in a fresh interpreter, and its exit code."""
+    started = time.perf_counter()
+    process = subprocess.run(
+        [sys.executable, "-c", "import sys; from mdi_envs.cli import main; "
+         "sys.exit(main(['compile', 'all']))"],
+        cwd=ROOT, env=_environment(cache, python_path), capture_output=True, text=True,
+        check=False,
+    )
+    return {"seconds": time.perf_counter() - started, "returncode": process.returncode,
+            "output": process.stdout.strip().splitlines()[-6:]}
+
+
+def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    seconds = [run["seconds"] for run in runs if "seconds" in run]
+    errors = [run["error"] for run in runs if "error" in run]
+    summary: dict[str, Any] = {"runs": runs}
+    if seconds:
+        summary.update(median=statistics.median(seconds), min=min(seconds))
+    if errors:
+        summary["errors"] = errors
+    return summary
+
+
+def run(quick: bool, output: Path, python_path: Path | None = None,
+        repeats: int = 5) -> str:
+    """Run the study, write ``startup.json`` / ``startup.png``, return the Markdown table."""
+    from mdi_envs import ENV_IDS
+
+    log = Progress()
+    record: dict[str, Any] = {"machine": machine_info(), "quick": quick,
+                              "python_path": str(python_path) if python_path else None,
+                              "target_ratio": TARGET_RATIO}
+    ids = list(ENV_IDS) + list(REFERENCES)
+    entries = ENTRIES[:2] if quick else ENTRIES
+    with tempfile.TemporaryDirectory(prefix="mdi-envs-cache-") as scratch:
+        cache = None if quick else Path(scratch) / "warm"
+        log(f"mdi-envs compile all ({'user cache' if quick else 'empty cache'})")
+        record["compile_all"] = compile_all(cache, python_path)
+        log(f"  {record['compile_all']['seconds']:.1f} s")
+        if not quick:
+            record["compile_all_warm"] = compile_all(cache, python_path)
+            log(f"  again, warm: {record['compile_all_warm']['seconds']:.1f} s")
+        warm_runs: dict[str, list[dict[str, Any]]] = {}
+        for repeat in range(1 if quick else repeats):
+            for env_id in ids:
+                for entry in entries:
+                    key = f"{env_id} {entry}"
+                    log(f"warm {repeat + 1}: {key}")
+                    warm_runs.setdefault(key, []).append(
+                        time_to_first_step(entry, env_id, cache, python_path))
+        record["warm"] = {key: _summary(runs) for key, runs in warm_runs.items()}
+        record["cold"] = {}
+        if not quick:
+            for env_id in ENV_IDS:
+                for entry in ENTRIES[:2]:
+                    log(f"cold: {env_id} {entry}")
+                    empty = Path(tempfile.mkdtemp(dir=scratch, prefix="cold-"))
+                    record["cold"][f"{env_id} {entry}"] = _summary(
+                        [time_to_first_step(entry, env_id, empty, python_path)])
+    record["ratios_to_acrobot"] = _ratios(record["warm"], entries)
+    record["targets"] = _targets(record, ENV_IDS, entries)
+    output.mkdir(parents=True, exist_ok=True)
+    (output / "startup.json").write_text(json.dumps(record, indent=2))
+    _plot(record, ids, entries, output / "startup.png")
+    return table(record)
+
+
+def _ratios(warm: dict[str, Any], entries: Sequence[str]) -> dict[str, float]:
+    """Warm median of every case over Acrobot-v1's in the same entry."""
+    ratios = {}
+    for entry in entries:
+        reference = warm.get(f"Acrobot-v1 {entry}", {}).get("median")
+        for key, summary in warm.items():
+            if key.endswith(f" {entry}") and reference and "median" in summary:
+                ratios[key] = summary["median"] / reference
+    return ratios
+
+
+def _targets(record: dict[str, Any], env_ids: Sequence[str],
+             entries: Sequence[str]) -> list[dict[str, Any]]:
+    """The issue's targets in the headline schema (``benchmarks.headline``)."""
+    ratios = {key: ratio for key, ratio in record["ratios_to_acrobot"].items()
+              if key.split(" ")[0] in env_ids and key.rsplit(" ", 1)[1] in ("single", "vector")}
+    targets = []
+    if ratios:
+        worst = max(ratios, key=ratios.__getitem__)
+        targets.append({
+            "target": "warm start to the first env step, every id, gym.make and gym.make_vec: "
+                      "time / Acrobot-v1's (worst case)",
+            "measured": ratios[worst], "threshold": record["target_ratio"], "unit": "×",
+            "comparison": "≤", "met": ratios[worst] <= record["target_ratio"],
+            "note": f"worst: {worst}, {record['warm'][worst]['median']:.2f} s",
+        })
+    if not record["quick"]:
+        seconds = record["compile_all"]["seconds"]
+        targets.append({
+            "target": "mdi-envs compile all on an empty cache", "measured": seconds,
+            "threshold": 30.0, "unit": "s", "comparison": "≤",
+            "met": seconds <= 30.0 and record["compile_all"]["returncode"] == 0,
+            "note": f"{os.cpu_count()} cores",
+        })
+    return targets
+
+
+def table(record: dict[str, Any]) -> str:
+    """The Markdown table of a ``startup.json`` record."""
+    compiled = record["compile_all"]
+    lines = [f"`mdi-envs compile all`: {compiled['seconds']:.1f} s "
+             f"({'user cache' if record['quick'] else 'empty cache'}, exit "
+             f"{compiled['returncode']})"
+             + (f"; again on the warm cache {record['compile_all_warm']['seconds']:.1f} s"
+                if "compile_all_warm" in record else ""), "",
+             "| env id | entry | warm median [s] | warm min [s] | / Acrobot-v1 (target ≤ "
+             f"{record['target_ratio']:g}) | cold [s] |", "|---|---|---|---|---|---|"]
+    for key, summary in record["warm"].items():
+        env_id, entry = key.rsplit(" ", 1)
+        ratio = record["ratios_to_acrobot"].get(key)
+        cold = record["cold"].get(key, {}).get("median")
+        failed = " (failed: " + summary["errors"][0] + ")" if "errors" in summary else ""
+        lines.append(
+            f"| {env_id} | {entry} | {summary.get('median', float('nan')):.2f}{failed} | "
+            f"{summary.get('min', float('nan')):.2f} | "
+            f"{'-' if ratio is None else f'{ratio:.2f}'} | "
+            f"{'-' if cold is None else f'{cold:.1f}'} |")
+    return "\n".join(lines)
+
+
+def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
+          path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = [env_id.removeprefix("mdi_envs/") for env_id in ids]
+    figure, axis = plt.subplots(figsize=(9, 4.5))
+    width = 0.8 / (len(entries) + 1)
+    for e, entry in enumerate(entries):
+        values = [record["warm"].get(f"{env_id} {entry}", {}).get("median", 0.0)
+                  for env_id in ids]
+        positions = [i + e * width for i in range(len(ids))]
+        axis.bar(positions, values, width, label=f"warm, {entry}")
+    colds = [record["cold"].get(f"{env_id} single", {}).get("median", 0.0) for env_id in ids]
+    if any(colds):
+        axis.bar([i + len(entries) * width for i in range(len(ids))], colds, width,
+                 label="cold (empty cache), single", hatch="//", color="0.8", edgecolor="0.4")
+    acrobot = record["warm"].get("Acrobot-v1 single", {}).get("median")
+    if acrobot:
+        axis.axhline(record["target_ratio"] * acrobot, color="k", linestyle="--", linewidth=1,
+                     label=f"{record['target_ratio']:g}× Acrobot-v1 (single, warm)")
+    axis.set_yscale("log")
+    axis.set_xticks([i + 0.4 - width / 2 for i in range(len(ids))], labels, rotation=15)
+    axis.set_ylabel("interpreter start → first step returned [s]")
+    axis.set_title("Start-up time, fresh processes"
+                   + (" (quick: warm, one run)" if record["quick"] else ""))
+    axis.legend(fontsize=8)
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--output", type=Path, default=Path("results/bench"),
+                        help="output folder")
+    parser.add_argument("--quick", action="store_true",
+                        help="warm single and vector cases once, on the user's cache")
+    parser.add_argument("--python-path", type=Path, default=None,
+                        help="run the probes on the package in this folder (PYTHONPATH)")
+    parser.add_argument("--repeats", type=int, default=5, help="warm repetitions (full run)")
+    args = parser.parse_args(argv)
+    print(run(args.quick, args.output, args.python_path, args.repeats))
+    record = json.loads((args.output / "startup.json").read_text())
+    failed = [key for key, summary in record["warm"].items() if "errors" in summary]
+    return 1 if failed or record["compile_all"]["returncode"] != 0 else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
