@@ -20,8 +20,8 @@ from mdi_envs.solvers.status import SolverStatus
 METHODS = FC3D_METHODS.names()
 
 
-def test_both_methods_are_registered() -> None:
-    assert METHODS == ["newton_ac", "nsgs"]
+def test_all_methods_are_registered() -> None:
+    assert METHODS == ["hybrid", "newton_ac", "nsgs"]
     assert set(FC3D_METHODS.summaries()) == set(METHODS)
 
 

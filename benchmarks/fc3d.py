@@ -1,0 +1,172 @@
+"""FC3D on every Siconos peer problem: time and residual of each method, to tolerance 1e-8.
+
+Usage (from the repository root)::
+
+    python -m benchmarks.fc3d --output benchmarks/results          # about 4 min
+    python -m benchmarks.fc3d --output /tmp/fc3d --quick           # problems with n <= 150
+
+Runs ``solve_fc3d`` with ``newton_ac`` and ``nsgs`` (the methods before issue 23: the previous
+numbers) and ``hybrid`` (sparse Newton with a Levenberg shift chained with NSGS sweeps) on each
+``fc3d/*.dat`` file of the peer data, from r = 0. Each result's residual is recomputed with
+``fc3d_residual``; a problem counts as solved when some method reports CONVERGED (residual
+<= 1e-8). A call shorter than 20 ms is repeated and its median time kept. Writes ``fc3d.json``
+and ``fc3d.png`` (time and residual per problem and method) and prints the Markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from benchmarks import report  # noqa: E402
+from benchmarks.problems import peer_data_dir  # noqa: E402
+from benchmarks.timing import Progress, load_average, machine_info  # noqa: E402
+from mdi_envs.solvers import SolverStatus, fc3d_residual, solve_fc3d  # noqa: E402
+from mdi_envs.solvers.siconos_io import read_friction_contact  # noqa: E402
+
+TOL = 1e-8
+METHODS: dict[str, dict[str, Any]] = {
+    "newton_ac": {"max_iter": 100},
+    "nsgs": {"max_iter": 2000},
+    "hybrid": {"max_iter": 500},
+}
+"""Method -> options of the run (budgets: Newton steps or sweeps)."""
+
+QUICK_MAX_N = 150
+REPEAT_BELOW_S = 0.02
+
+
+def time_solve(data: Any, method: str, options: dict[str, Any]) -> tuple[Any, float]:
+    """Solve once (repeated while short) and return the result and the median time in s."""
+    times = []
+    while True:
+        start = time.perf_counter()
+        result = solve_fc3d(data.W, data.q, data.mu, method=method, tol=TOL, **options)
+        times.append(time.perf_counter() - start)
+        if sum(times) > REPEAT_BELOW_S * 5 or times[0] > REPEAT_BELOW_S or len(times) >= 50:
+            return result, float(np.median(times))
+
+
+def warm_up() -> None:
+    """Compile (or load) every method's kernels outside the timed calls."""
+    W = np.eye(6) + 0.1
+    for method in METHODS:
+        solve_fc3d(W, np.array([-1.0, 0.5, 0.0, -1.0, 0.0, 2.0]), np.array([0.3, 0.3]),
+                   method=method)
+
+
+def run(output: Path, quick: bool) -> str:
+    """Run every method on every peer problem, write the JSON and the plot, return the table."""
+    log = Progress()
+    output.mkdir(parents=True, exist_ok=True)
+    folder = peer_data_dir() / "fc3d"
+    files = sorted(folder.glob("*.dat")) if folder.is_dir() else []
+    if not files:
+        log(f"peer data {folder} absent: nothing to run")
+    warm_up()
+    rows = []
+    for path in files:
+        data = read_friction_contact(path)
+        n = int(data.q.shape[0])
+        if quick and n > QUICK_MAX_N:
+            continue
+        row: dict[str, Any] = {"name": path.stem, "n": n, "contacts": n // 3}
+        for method, options in METHODS.items():
+            result, seconds = time_solve(data, method, options)
+            residual = float(fc3d_residual(data.W, data.q, data.mu, result.r))
+            row[method] = {
+                "time_s": seconds,
+                "residual": residual,
+                "status": result.status.name,
+                "iterations": int(result.num_iter),
+                "converged": result.status is SolverStatus.CONVERGED,
+            }
+        row["solved"] = any(row[m]["converged"] for m in METHODS)
+        rows.append(row)
+        log(f"{path.stem} (n={n}): " + ", ".join(
+            f"{m} {row[m]['status']} {row[m]['residual']:.1e} in {row[m]['time_s']:.3g} s"
+            for m in METHODS
+        ))
+    solved = {m: sum(r[m]["converged"] for r in rows) for m in METHODS}
+    record = {
+        "machine": {**machine_info(), "load_average_at_end": load_average()},
+        "config": {"quick": quick, "tol": TOL, "methods": METHODS},
+        "problems": rows,
+        "solved_by_method": solved,
+        "solved_by_any": sum(r["solved"] for r in rows),
+        "run_time_s": log.elapsed,
+    }
+    report.write_json(record, output / "fc3d.json")
+    plot(rows, output / "fc3d.png")
+    log(f"done in {log.elapsed:.0f} s; wrote fc3d.json and fc3d.png to {output}")
+    return markdown(record)
+
+
+def markdown(record: dict[str, Any]) -> str:
+    """The per-problem table and the counts."""
+    header = ["problem", "n"] + [f"{m} s · residual · status (iter)" for m in METHODS]
+    body = [
+        [row["name"], str(row["n"])] + [
+            f"{row[m]['time_s']:.3g} · {row[m]['residual']:.1e} · "
+            f"{'**' + row[m]['status'] + '**' if row[m]['converged'] else row[m]['status']} "
+            f"({row[m]['iterations']})"
+            for m in METHODS
+        ]
+        for row in record["problems"]
+    ]
+    counts = ", ".join(f"{m} {c}" for m, c in record["solved_by_method"].items())
+    return (
+        report.markdown_table(header, body)
+        + f"\n\nConverged to {TOL:g}: {counts}; by at least one method "
+        f"{record['solved_by_any']} of {len(record['problems'])}."
+    )
+
+
+def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
+    """Two panels per problem: time per method (log) and residual per method (log)."""
+    names = [f"{r['name']} (n={r['n']})" for r in rows]
+    y = np.arange(len(rows))
+    fig, (ax_t, ax_r) = plt.subplots(1, 2, figsize=(13, 0.25 * len(rows) + 2), sharey=True)
+    for k, method in enumerate(METHODS):
+        offset = (k - 1) * 0.27
+        times = [r[method]["time_s"] for r in rows]
+        residuals = [max(r[method]["residual"], 1e-18) for r in rows]
+        colors = [f"C{k}" if r[method]["converged"] else "lightgrey" for r in rows]
+        ax_t.barh(y + offset, times, 0.27, color=colors, edgecolor=f"C{k}", label=method)
+        ax_r.barh(y + offset, residuals, 0.27, color=colors, edgecolor=f"C{k}", label=method)
+    ax_r.axvline(TOL, color="k", lw=0.8, ls=":")
+    for ax, label in ((ax_t, "time per solve (s)"), (ax_r, "residual (0 drawn at 1e-18)")):
+        ax.set_xscale("log")
+        ax.set_xlabel(label)
+        ax.grid(True, axis="x", which="both", alpha=0.3)
+    ax_t.set_yticks(y, names, fontsize=7)
+    ax_t.invert_yaxis()
+    ax_t.legend(fontsize=8, title="grey fill: not converged", title_fontsize=7)
+    fig.suptitle(f"FC3D on the Siconos peer problems, tol {TOL:g}, from r = 0")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
+    parser.add_argument(
+        "--quick", action="store_true", help=f"only problems with n <= {QUICK_MAX_N}"
+    )
+    args = parser.parse_args(argv)
+    print(run(args.output, args.quick))
+
+
+if __name__ == "__main__":
+    main()
