@@ -213,7 +213,12 @@ def test_an_edited_package_recompiles_with_its_new_code(
     assert edited["q"] == results[0]["q"]  # the same step, judged differently
 
 
-def test_subproc_vec_env_workers_starting_together_on_an_empty_cache(tmp_path: Path) -> None:
+def test_subproc_vec_env_workers_compiling_together(
+        shared_cache: tuple[Path, list[dict]]) -> None:
+    # the package's solver kernels are in the shared cache; the ball's step and task kernels
+    # are not: both workers compile them at once
+    cache, _ = shared_cache
+    assert not list(cache.glob("*/kernels/mdi_envs_kernels_task_BouncingBall*.py"))
     script = (
         "import numpy as np, mdi_envs\n"
         "from stable_baselines3.common.env_util import make_vec_env\n"
@@ -227,9 +232,9 @@ def test_subproc_vec_env_workers_starting_together_on_an_empty_cache(tmp_path: P
         "    print(repr(obs.tolist()))\n"
     )
     runs = [subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                           env=_environment(tmp_path), timeout=900, check=False)
+                           env=_environment(cache), timeout=900, check=False)
             for _ in range(2)]
     for run in runs:
         assert run.returncode == 0, run.stderr[-3000:]
     assert runs[0].stdout == runs[1].stdout  # the second run, from the cache, agrees
-    assert list((tmp_path).glob("*/kernels/mdi_envs_kernels_task_BouncingBall*.py"))
+    assert list(cache.glob("*/kernels/mdi_envs_kernels_task_BouncingBall*.py"))

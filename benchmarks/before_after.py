@@ -1,0 +1,138 @@
+"""Speed before and after a change, in one run: the engine and env benchmarks on two trees.
+
+``python -m benchmarks.before_after --before DIR [--rounds 2] [--output benchmarks/results]``
+runs ``benchmarks.engine --quick`` and ``benchmarks.envs --quick`` alternately (before, after,
+before, after, ...) in fresh interpreters, the ``before`` ones on the package in DIR (a
+checkout of the earlier commit, e.g. ``git worktree add /tmp/before c88c156``), the ``after``
+ones on this tree, and compares every speed target the two benchmarks record (µs per step,
+steps per second): the median over the rounds per tree and their ratio. Writes
+``before_after.json`` and ``before_after.png``, prints a Markdown table. Alternating the trees
+spreads this VM's slow phases over both. About 3 min per round (plus the before tree's
+compilation: it has no disk cache).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from benchmarks.timing import Progress, machine_info
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCHMARKS = (("engine", "engine.json"), ("envs", "envs.json"))
+LIMIT = 1.10
+"""An 'after' step may be at most this factor slower than 'before' (lower-is-better units)."""
+
+
+def _targets(record: dict[str, Any]) -> dict[str, tuple[float, str]]:
+    """{target: (measured, unit)} of a benchmark record (both of the suite's spellings)."""
+    found = {}
+    for target in record.get("targets") or []:
+        if "measured_us" in target:
+            found[target["target"]] = (float(target["measured_us"]), "µs")
+        elif isinstance(target.get("measured"), (int, float)):
+            found[target["target"]] = (float(target["measured"]), target.get("unit", ""))
+    return found
+
+
+def _lower_is_better(unit: str) -> bool:
+    return "/s" not in unit and "×" not in unit and "per s" not in unit
+
+
+def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]]:
+    """Run ``benchmarks.<name> --quick`` on the package in ``tree``; its targets."""
+    environment = {**os.environ, "PYTHONPATH": str(tree)}
+    process = subprocess.run(
+        [sys.executable, "-m", f"benchmarks.{name}", "--quick", "--output", str(folder)],
+        cwd=tree, env=environment, capture_output=True, text=True, check=False,
+    )
+    if process.returncode != 0:
+        raise RuntimeError(f"benchmarks.{name} on {tree} failed: "
+                           f"{process.stderr.strip().splitlines()[-1:]}")
+    filename = dict(BENCHMARKS)[name]
+    return _targets(json.loads((folder / filename).read_text()))
+
+
+def run(before: Path, rounds: int, output: Path) -> str:
+    """Alternate the trees ``rounds`` times, write the JSON and PNG, return the table."""
+    log = Progress()
+    samples: dict[str, dict[str, list[float]]] = {"before": {}, "after": {}}
+    units: dict[str, str] = {}
+    with tempfile.TemporaryDirectory(prefix="before-after-") as scratch:
+        for round_index in range(rounds):
+            for label, tree in (("before", before), ("after", ROOT)):
+                for name, _ in BENCHMARKS:
+                    log(f"round {round_index + 1}/{rounds}: {name} on {label} ({tree})")
+                    folder = Path(scratch) / f"{label}-{name}-{round_index}"
+                    for target, (value, unit) in run_once(tree, name, folder).items():
+                        samples[label].setdefault(f"{name}: {target}", []).append(value)
+                        units[f"{name}: {target}"] = unit
+    rows = []
+    for target in samples["after"]:
+        if target not in samples["before"]:
+            continue
+        old = statistics.median(samples["before"][target])
+        new = statistics.median(samples["after"][target])
+        unit = units[target]
+        slowdown = new / old if _lower_is_better(unit) else old / new
+        rows.append({"target": target, "unit": unit, "before": old, "after": new,
+                     "slowdown": slowdown, "ok": slowdown <= LIMIT,
+                     "before_runs": samples["before"][target],
+                     "after_runs": samples["after"][target]})
+    record = {"machine": machine_info(), "before_tree": str(before), "rounds": rounds,
+              "limit": LIMIT, "rows": rows}
+    output.mkdir(parents=True, exist_ok=True)
+    (output / "before_after.json").write_text(json.dumps(record, indent=2))
+    _plot(rows, output / "before_after.png")
+    lines = ["| target | unit | before (median) | after (median) | slowdown after/before "
+             f"(limit {LIMIT:g}) |", "|---|---|---|---|---|"]
+    lines += [f"| {row['target']} | {row['unit']} | {row['before']:.4g} | {row['after']:.4g} "
+              f"| {row['slowdown']:.3f}{'' if row['ok'] else ' (over)'} |" for row in rows]
+    return "\n".join(lines)
+
+
+def _plot(rows: list[dict[str, Any]], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axis = plt.subplots(figsize=(9, 0.35 * len(rows) + 1.5))
+    labels = [row["target"][:70] for row in rows]
+    axis.barh(range(len(rows)), [row["slowdown"] for row in rows],
+              color=["tab:green" if row["ok"] else "tab:red" for row in rows])
+    axis.axvline(1.0, color="k", linewidth=1)
+    axis.axvline(LIMIT, color="tab:red", linestyle="--", linewidth=1, label=f"limit {LIMIT:g}")
+    axis.set_yticks(range(len(rows)), labels, fontsize=7)
+    axis.set_xlabel("after / before (time; inverse for rates): > 1 is slower")
+    axis.legend(fontsize=8)
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point; returns 1 if a target got slower than the limit."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--before", type=Path, required=True,
+                        help="a checkout of the earlier commit")
+    parser.add_argument("--rounds", type=int, default=2, help="alternations (default 2)")
+    parser.add_argument("--output", type=Path, default=Path("benchmarks/results"))
+    args = parser.parse_args(argv)
+    if not (args.before / "mdi_envs" / "__init__.py").exists():
+        raise SystemExit(f"--before {args.before}: no mdi_envs package there")
+    print(run(args.before.resolve(), args.rounds, args.output))
+    record = json.loads((args.output / "before_after.json").read_text())
+    return 0 if all(row["ok"] for row in record["rows"]) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
