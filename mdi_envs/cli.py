@@ -57,11 +57,16 @@ def _build_parser() -> argparse.ArgumentParser:
 
     solve = commands.add_parser(
         "solve",
-        help="solve one Siconos-format LCP file and report the result",
-        description="Read an LCP in Siconos' text format (n, matrix block, q) and solve it.",
+        help="solve one Siconos-format LCP or friction-contact file and report the result",
+        description="Read an LCP (n, matrix block, q) or, with --problem friction, a local "
+        "friction-contact problem (dimension 2 or 3, W, q, mu) in Siconos' text format and "
+        "solve it (solve_lcp, solve_fc2d or solve_fc3d).",
     )
     solve.add_argument("path", type=Path, help="the .dat file")
-    solve.add_argument("--method", default="lemke", help="LCP method (default: lemke)")
+    solve.add_argument("--problem", choices=("lcp", "friction"), default="lcp",
+                       help="the file's problem type (default: lcp)")
+    solve.add_argument("--method", default=None,
+                       help="method (default: lemke for an LCP, newton_ac for friction)")
     solve.set_defaults(handler=_run_solve)
 
     simulate = commands.add_parser(
@@ -92,8 +97,8 @@ def _build_parser() -> argparse.ArgumentParser:
         description="Compile (or load) every kernel an environment id uses: gym.make and "
         "gym.make_vec with each documented variant, and the model's stepper; one worker "
         "process per id, all cores. The kernels are cached on disk (MDI_ENVS_CACHE_DIR, "
-        "default ~/.cache/mdi_envs) and shared by every later process. Takes about 30-60 s "
-        "on an empty cache, about a second per id on a warm one.",
+        "default ~/.cache/mdi_envs) and shared by every later process. Takes a few minutes "
+        "on an empty cache (every kernel compiled), seconds on a warm one.",
     )
     compile_.add_argument("env_ids", nargs="*", default=["all"], metavar="ENV_ID",
                           help="ids to compile, or 'all' (default)")
@@ -294,12 +299,25 @@ def _manipulator_demo(output: Path) -> Path:
 
 
 def _run_solve(args: argparse.Namespace) -> int:
-    from mdi_envs.solvers import solve_lcp
-    from mdi_envs.solvers.siconos_io import read_lcp
+    from mdi_envs.solvers import solve_fc2d, solve_fc3d, solve_lcp
+    from mdi_envs.solvers.siconos_io import read_friction_contact, read_lcp
 
+    if args.problem == "friction":
+        data = read_friction_contact(args.path, sparse=True)
+        solve, W = ((solve_fc2d, data.W) if data.dimension == 2
+                    else (solve_fc3d, data.W.toarray()))  # fmt: skip
+        start = time.perf_counter()
+        result = solve(W, data.q, data.mu, method=args.method or "newton_ac")
+        elapsed = time.perf_counter() - start
+        print(f"{args.path.name}: {data.mu.shape[0]} contacts of dimension {data.dimension}, "
+              f"method {result.method}")
+        print(f"status {result.status.name}, {result.num_iter} iterations, residual "
+              f"{result.residual:.3e}, {elapsed * 1e3:.2f} ms (including compilation on "
+              "first use)")
+        return 0 if result.status.name == "CONVERGED" else 1
     M, q = read_lcp(args.path)
     start = time.perf_counter()
-    result = solve_lcp(M, q, method=args.method)
+    result = solve_lcp(M, q, method=args.method or "lemke")
     elapsed = time.perf_counter() - start
     print(f"{args.path.name}: n = {q.shape[0]}, method {result.method}")
     print(f"status {result.status.name}, {result.num_iter} iterations, residual "

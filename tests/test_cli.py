@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from peer_data import peer_params
 
 from mdi_envs.cli import main
 
@@ -43,6 +44,15 @@ def test_solve_reads_a_siconos_file(tmp_path: Path, capsys: pytest.CaptureFixtur
     out = capsys.readouterr().out
     assert "status CONVERGED" in out
     assert "1.333333" in out and "2.333333" in out
+
+
+@pytest.mark.parametrize("path", peer_params("fc2d", ["FC2D_SliderCrankLagrangian00000"])
+                         + peer_params("fc3d", ["FC3D_Example1"]))
+def test_solve_reads_a_friction_contact_file(path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["solve", "--problem", "friction", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "status CONVERGED" in out and "contacts of dimension" in out
 
 
 def test_solve_reports_a_ray_with_exit_code(tmp_path: Path) -> None:
