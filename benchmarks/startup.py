@@ -1,4 +1,4 @@
-"""Start-up time: from interpreter start to the first env step returned (``mdi-envs bench startup``).
+"""Start-up time: interpreter start to the first env step returned (``mdi-envs bench startup``).
 
 For every registered id and for Gymnasium's Acrobot-v1 and MuJoCo's InvertedDoublePendulum-v5,
 each case runs ``benchmarks.startup_probe`` in a fresh interpreter and takes the wall-clock time
@@ -29,10 +29,12 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from benchmarks.startup_probe import FLOOR
 from benchmarks.timing import Progress, machine_info
 
 REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
-"""Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run."""
+"""Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
+row, ``startup_probe.FLOOR``) the floor of any numba env: one trivial cached kernel's load."""
 ENTRIES = ("single", "vector", "subproc")
 TARGET_RATIO = 2.0
 """Warm start-up target: within this factor of Acrobot-v1's, entry by entry."""
@@ -100,7 +102,7 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
     record: dict[str, Any] = {"machine": machine_info(), "quick": quick,
                               "python_path": str(python_path) if python_path else None,
                               "target_ratio": TARGET_RATIO}
-    ids = list(ENV_IDS) + list(REFERENCES)
+    ids = list(ENV_IDS) + list(REFERENCES) + [FLOOR]
     entries = ENTRIES[:2] if quick else ENTRIES
     with tempfile.TemporaryDirectory(prefix="mdi-envs-cache-") as scratch:
         cache = None if quick else Path(scratch) / "warm"
@@ -113,7 +115,7 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
         warm_runs: dict[str, list[dict[str, Any]]] = {}
         for repeat in range(1 if quick else repeats):
             for env_id in ids:
-                for entry in entries:
+                for entry in entries[:1] if env_id == FLOOR else entries:
                     key = f"{env_id} {entry}"
                     log(f"warm {repeat + 1}: {key}")
                     warm_runs.setdefault(key, []).append(
