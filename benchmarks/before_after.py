@@ -1,10 +1,11 @@
 """Speed before and after a change, in one run: the engine and env benchmarks on two trees.
 
 ``python -m benchmarks.before_after --before DIR [--rounds 2] [--output benchmarks/results]``
-runs ``benchmarks.engine --quick`` and ``benchmarks.envs --quick`` alternately (before, after,
-before, after, ...) in fresh interpreters, the ``before`` ones on the package in DIR (a
-checkout of the earlier commit, e.g. ``git worktree add /tmp/before c88c156``), the ``after``
-ones on this tree, and compares every speed target the two benchmarks record (µs per step,
+runs ``benchmarks.engine --quick --models manipulator,diff_drive`` and ``benchmarks.envs
+--quick`` alternately (before, after, before, after, ...) in fresh interpreters, the ``before``
+ones on the package in DIR (a checkout of the earlier commit, e.g. ``git worktree add
+/tmp/before c88c156``), the ``after`` ones on this tree, both with this tree's benchmark code,
+and compares every speed target the two benchmarks record (µs per step,
 steps per second): the median over the rounds per tree and their ratio. Writes
 ``before_after.json`` and ``before_after.png``, prints a Markdown table. Alternating the trees
 spreads this VM's slow phases over both. About 3 min per round (plus the before tree's
@@ -49,12 +50,31 @@ def _lower_is_better(unit: str) -> bool:
     return "/s" not in unit and "×" not in unit and "per s" not in unit
 
 
+ARGUMENTS = {"engine": ("--quick", "--models", "manipulator,diff_drive"), "envs": ("--quick",)}
+"""Each benchmark's arguments: quick budgets; the engine on both mission models."""
+
+
+def _harness(tree: Path, scratch: Path) -> Path:
+    """A folder with ``tree``'s packages and this tree's ``benchmarks``.
+
+    So the same measuring code runs on both trees (symbolic links, in ``scratch``).
+    """
+    folder = scratch / f"harness-{abs(hash(str(tree)))}"
+    if not folder.exists():
+        folder.mkdir()
+        for package in ("mdi_envs", "optimal", "baselines"):
+            (folder / package).symlink_to(tree / package)
+        (folder / "benchmarks").symlink_to(ROOT / "benchmarks")
+    return folder
+
+
 def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]]:
-    """Run ``benchmarks.<name> --quick`` on the package in ``tree``; its targets."""
-    environment = {**os.environ, "PYTHONPATH": str(tree)}
+    """Run ``benchmarks.<name>`` (``ARGUMENTS``) on the package in ``tree``; its targets."""
+    harness = _harness(tree, folder.parent)
+    environment = {**os.environ, "PYTHONPATH": str(harness)}
     process = subprocess.run(
-        [sys.executable, "-m", f"benchmarks.{name}", "--quick", "--output", str(folder)],
-        cwd=tree, env=environment, capture_output=True, text=True, check=False,
+        [sys.executable, "-m", f"benchmarks.{name}", *ARGUMENTS[name], "--output", str(folder)],
+        cwd=harness, env=environment, capture_output=True, text=True, check=False,
     )
     if process.returncode != 0:
         raise RuntimeError(f"benchmarks.{name} on {tree} failed: "

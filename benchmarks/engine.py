@@ -27,7 +27,7 @@ from __future__ import annotations
 import argparse
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -596,8 +596,18 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
     parser.add_argument("--quick", action="store_true",
                         help="manipulator and MuJoCo only, small grid and budgets (~20 s)")
+    parser.add_argument("--models", default=None,
+                        help=f"comma-separated models instead of the run's own (of "
+                        f"{', '.join(FULL.models)})")
     args = parser.parse_args(argv)
-    print(run(QUICK if args.quick else FULL, args.output, args.quick))
+    config = QUICK if args.quick else FULL
+    if args.models:
+        models = tuple(args.models.split(","))
+        unknown = [model for model in models if model not in FULL.models]
+        if unknown:
+            raise SystemExit(f"--models: unknown {unknown}; choose from {FULL.models}")
+        config = replace(config, models=models)
+    print(run(config, args.output, args.quick))
 
 
 if __name__ == "__main__":

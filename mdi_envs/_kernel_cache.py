@@ -29,7 +29,8 @@ complete files, the last rename wins, and a reader sees an old or a new file, ne
 one.
 
 The cache root is ``$MDI_ENVS_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/mdi_envs`` or
-``~/.cache/mdi_envs`` (``%LOCALAPPDATA%/mdi_envs`` on Windows). Under ``NUMBA_DISABLE_JIT=1``
+``~/.cache/mdi_envs`` (``%LOCALAPPDATA%/mdi_envs`` on Windows); if it cannot be written, a
+folder in the system's temporary directory, with a warning. Under ``NUMBA_DISABLE_JIT=1``
 nothing is written and ``freeze`` returns the closures as they are.
 """
 
@@ -46,6 +47,7 @@ import sys
 import tempfile
 import textwrap
 import types
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -182,14 +184,15 @@ def _load(name: str, source: str) -> types.ModuleType:
     module_name = f"mdi_envs_kernels_{name}_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
     if module_name in sys.modules:
         return sys.modules[module_name]
-    directory = digest_dir() / "kernels"
-    path = directory / f"{module_name}.py"
-    if not path.exists():
-        directory.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(dir=directory, prefix=".", suffix=".tmp")
-        with os.fdopen(handle, "w", encoding="utf-8") as file:
-            file.write(source)
-        os.replace(temporary, path)
+    try:
+        path = _write(digest_dir() / "kernels", f"{module_name}.py", source)
+    except OSError as error:
+        user = os.getuid() if hasattr(os, "getuid") else os.getlogin()
+        fallback = Path(tempfile.gettempdir()) / f"mdi_envs-{user}" / _DIGEST / "kernels"
+        warnings.warn(f"mdi_envs: cannot write the kernel cache under {cache_root()} "
+                      f"({error}); using {fallback} (set {CACHE_DIR_VARIABLE} to a writable "
+                      "folder)", RuntimeWarning, stacklevel=3)
+        path = _write(fallback, f"{module_name}.py", source)
     spec = importlib.util.spec_from_file_location(module_name, path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
@@ -200,6 +203,18 @@ def _load(name: str, source: str) -> types.ModuleType:
         del sys.modules[module_name]
         raise
     return module
+
+
+def _write(directory: Path, filename: str, source: str) -> Path:
+    """``directory/filename`` holding ``source``, written atomically unless it exists."""
+    path = directory / filename
+    if not path.exists():
+        directory.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(dir=directory, prefix=".", suffix=".tmp")
+        with os.fdopen(handle, "w", encoding="utf-8") as file:
+            file.write(source)
+        os.replace(temporary, path)
+    return path
 
 
 def _importable(value: Any) -> tuple[str, str] | None:

@@ -116,6 +116,19 @@ def test_a_changed_constant_is_a_new_module(tmp_path: Path,
     assert again["scaled"] is two["scaled"]  # same source: the same module
 
 
+def test_an_unwritable_cache_falls_back_with_a_warning(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    blocked = tmp_path / "file"
+    blocked.write_text("a file, not a folder")
+    monkeypatch.setenv(CACHE_DIR_VARIABLE, str(blocked / "cache"))
+    monkeypatch.setattr(_kernel_cache.tempfile, "gettempdir", lambda: str(tmp_path))
+    with pytest.warns(RuntimeWarning, match="cannot write the kernel cache"):
+        frozen = freeze("test_fallback", _make_kernels(5.0))
+    assert frozen["scaled"](1.0) == 1.5 * 5.0 + 7.5
+    assert Path(sys.modules[frozen["scaled"].py_func.__module__].__file__).is_relative_to(
+        tmp_path)
+
+
 def test_freeze_refuses_values_it_cannot_write(tmp_path: Path,
                                                monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv(CACHE_DIR_VARIABLE, str(tmp_path))
