@@ -6,7 +6,9 @@ runs ``benchmarks.engine --quick --models manipulator,diff_drive`` and ``benchma
 ones on the package in DIR (a checkout of the earlier commit, e.g. ``git worktree add
 /tmp/before c88c156``), the ``after`` ones on this tree, both with this tree's benchmark code,
 and compares every speed target the two benchmarks record (µs per step,
-steps per second): the median over the rounds per tree and their ratio. Writes
+steps per second): the median over the rounds per tree and their ratio. Each run's speed probe
+(a compiled no-op call, ``benchmarks.timing.speed_probe``) is a row too: where it moved, the
+machine's phase did. Writes
 ``before_after.json`` and ``before_after.png``, prints a Markdown table. Alternating the trees
 spreads this VM's slow phases over both. About 3 min per round (plus the before tree's
 compilation: it has no disk cache).
@@ -80,7 +82,12 @@ def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]
         raise RuntimeError(f"benchmarks.{name} on {tree} failed: "
                            f"{process.stderr.strip().splitlines()[-1:]}")
     filename = dict(BENCHMARKS)[name]
-    return _targets(json.loads((folder / filename).read_text()))
+    record = json.loads((folder / filename).read_text())
+    found = _targets(record)
+    probe = (record.get("machine") or {}).get("speed_probe_at_start") or {}
+    if "median_us" in probe:  # the VM's phase at the run's start (benchmarks.timing)
+        found["speed probe at start (compiled no-op call, median)"] = (probe["median_us"], "µs")
+    return found
 
 
 def run(before: Path, rounds: int, output: Path) -> str:
