@@ -8,7 +8,8 @@ ones on the package in DIR (a checkout of the earlier commit, e.g. ``git worktre
 and compares every speed target the two benchmarks record (µs per step,
 steps per second): the median over the rounds per tree and their ratio. Each run's speed probe
 (a compiled no-op call, ``benchmarks.timing.speed_probe``) is a row too: where it moved, the
-machine's phase did. Writes
+machine's phase did. Each round also runs ``benchmarks.in_place_probe`` on both mission models:
+the minimum over 300 batches is the code's speed, robust to those phases. Writes
 ``before_after.json`` and ``before_after.png``, prints a Markdown table. Alternating the trees
 spreads this VM's slow phases over both. About 3 min per round (plus the before tree's
 compilation: it has no disk cache).
@@ -90,6 +91,18 @@ def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]
     return found
 
 
+def in_place_once(tree: Path, model: str, scratch: Path) -> tuple[float, float]:
+    """(min, median) µs of ``benchmarks.in_place_probe MODEL`` on the package in ``tree``."""
+    harness = _harness(tree, scratch)
+    process = subprocess.run(
+        [sys.executable, "-m", "benchmarks.in_place_probe", model], cwd=harness,
+        env={**os.environ, "PYTHONPATH": str(harness)}, capture_output=True, text=True,
+        check=True,
+    )
+    fastest, median = process.stdout.split()
+    return float(fastest), float(median)
+
+
 def run(before: Path, rounds: int, output: Path) -> str:
     """Alternate the trees ``rounds`` times, write the JSON and PNG, return the table."""
     log = Progress()
@@ -104,6 +117,13 @@ def run(before: Path, rounds: int, output: Path) -> str:
                     for target, (value, unit) in run_once(tree, name, folder).items():
                         samples[label].setdefault(f"{name}: {target}", []).append(value)
                         units[f"{name}: {target}"] = unit
+                for model in ("manipulator", "diff_drive"):
+                    fastest, median = in_place_once(tree, model, Path(scratch))
+                    for statistic, value in (("min", fastest), ("median", median)):
+                        key = (f"in-place probe: {model} InPlaceStepper.step(), {statistic} "
+                               "over 300 batches")
+                        samples[label].setdefault(key, []).append(value)
+                        units[key] = "µs"
     rows = []
     for target in samples["after"]:
         if target not in samples["before"]:

@@ -1,0 +1,44 @@
+"""Run in a fresh interpreter by ``benchmarks.before_after``: the fastest in-place single step.
+
+``python -m benchmarks.in_place_probe MODEL`` (``manipulator``: arm from rest under a 0.1 N m
+torque, dt = 1 ms, brake released; ``diff_drive``: robot from rest under wheel torques (1, 0.4)
+N m, dt = 10 ms, turning): 1000 warm-up steps, then 300 batches of 200 ``InPlaceStepper.step()``
+calls; prints the minimum and the median µs per step over the batches. The minimum is the code's
+speed; the median moves with this VM's slow phases (about 2x, seconds long).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from mdi_envs.mechanics import BlockableManipulator, DiffDriveRobot
+from mdi_envs.stepping import MoreauJeanStepper
+
+SCENES = {"manipulator": (BlockableManipulator, 1e-3, (0.1,)),
+          "diff_drive": (DiffDriveRobot, 1e-2, (1.0, 0.4))}
+
+
+def main(model_name: str) -> None:
+    """Print ``min median`` [µs per step] of the scene's in-place step."""
+    model, time_step, torques = SCENES[model_name]
+    stepper = MoreauJeanStepper(model, time_step=time_step).in_place(
+        np.zeros(model.NUM_DOFS), np.zeros(model.NUM_DOFS))
+    stepper.tau[:] = torques
+    step = stepper.step
+    for _ in range(1000):
+        step()
+    per_step = []
+    for _ in range(300):
+        began = time.perf_counter()
+        for _ in range(200):
+            step()
+        per_step.append((time.perf_counter() - began) / 200 * 1e6)
+    per_step.sort()
+    print(f"{per_step[0]:.6f} {per_step[len(per_step) // 2]:.6f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
