@@ -170,7 +170,7 @@ def freeze(name: str, kernels: Mapping[str, Any]) -> dict[str, Any]:
     Raises:
         TypeError: a kernel reaches a value that cannot be written as source (e.g. an array).
     """
-    if config.DISABLE_JIT:
+    if config.DISABLE_JIT:  # type: ignore[attr-defined]  # numba sets it at run time
         return dict(kernels)
     writer = _ModuleWriter(reserved=kernels)
     exports = {key: writer.bind(value, key) for key, value in kernels.items()}
@@ -225,7 +225,7 @@ def _importable(value: Any) -> tuple[str, str] | None:
     module = sys.modules.get(module_name) if isinstance(module_name, str) else None
     if module is None or not isinstance(qualname, str) or "." in qualname or "<" in qualname:
         return None
-    return (module_name, qualname) if getattr(module, qualname, None) is value else None
+    return (str(module_name), qualname) if getattr(module, qualname, None) is value else None
 
 
 def _is_literal(value: Any) -> bool:

@@ -304,17 +304,19 @@ def _run_solve(args: argparse.Namespace) -> int:
 
     if args.problem == "friction":
         data = read_friction_contact(args.path, sparse=True)
-        solve, W = ((solve_fc2d, data.W) if data.dimension == 2
-                    else (solve_fc3d, data.W.toarray()))  # fmt: skip
+        method = args.method or "newton_ac"
         start = time.perf_counter()
-        result = solve(W, data.q, data.mu, method=args.method or "newton_ac")
+        contact: Any = (solve_fc2d(data.W, data.q, data.mu, method=method)
+                        if data.dimension == 2 else
+                        solve_fc3d(np.asarray(data.W.todense()),  # type: ignore[union-attr]
+                                   data.q, data.mu, method=method))
         elapsed = time.perf_counter() - start
         print(f"{args.path.name}: {data.mu.shape[0]} contacts of dimension {data.dimension}, "
-              f"method {result.method}")
-        print(f"status {result.status.name}, {result.num_iter} iterations, residual "
-              f"{result.residual:.3e}, {elapsed * 1e3:.2f} ms (including compilation on "
+              f"method {contact.method}")
+        print(f"status {contact.status.name}, {contact.num_iter} iterations, residual "
+              f"{contact.residual:.3e}, {elapsed * 1e3:.2f} ms (including compilation on "
               "first use)")
-        return 0 if result.status.name == "CONVERGED" else 1
+        return 0 if contact.status.name == "CONVERGED" else 1
     M, q = read_lcp(args.path)
     start = time.perf_counter()
     result = solve_lcp(M, q, method=args.method or "lemke")

@@ -1,5 +1,7 @@
 """Simulation: the Moreau-Jean stepper (single and batched), the event-driven reference."""
 
+from typing import Any
+
 from mdi_envs.stepping._kernel import StepShortcuts
 from mdi_envs.stepping.in_place import InPlaceStepper
 from mdi_envs.stepping.moreau_jean import MoreauJeanStepper, StepResult
@@ -8,7 +10,7 @@ _EVENT_DRIVEN_NAMES = ("EventDrivenIntegrator", "PiecewiseConstant", "Trajectory
                        "brake_schedule", "simulate_ball", "simulate_manipulator")
 
 
-def __getattr__(name: str) -> object:
+def __getattr__(name: str) -> Any:
     """The event-driven reference's names, imported on first use.
 
     ``event_driven`` needs scipy.integrate, about 0.3 s to import that a process which only
