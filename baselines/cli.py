@@ -4,9 +4,9 @@ Wiring (in ``mdi_envs/cli.py``): ``from baselines.cli import add_train_parser`` 
 ``add_train_parser(commands)`` on the subparsers; the parser's handler is ``run_train``.
 Example: ``mdi-envs train mdi_envs/DiffDriveRobot-v0 PPO --task effort --output
 results/baselines`` (5 x 10^6 steps; the budget and settings are in
-``baselines/hyperparameters.py``) shows SB3's progress bar on a terminal and writes the model
-zip, its JSON config, the episode CSV, the training-curve PNG and TensorBoard logs into
-``--output``. ``--timesteps 20000`` gives a run of a minute or two. ``mdi-envs train
+``baselines/hyperparams/*.yml``, rl-zoo3's format) shows SB3's progress bar on a terminal and
+writes the model zip, its JSON config, the episode CSV, the training-curve PNG and TensorBoard
+logs into ``--output``. ``--timesteps 20000`` gives a run of a minute or two. ``mdi-envs train
 mdi_envs/BlockableManipulator-v0 HybridPPO`` trains ``baselines.hybrid_ppo.HybridPPO`` on the
 manipulator's native hybrid action space (algorithm names are case-insensitive).
 """
@@ -27,8 +27,8 @@ def add_train_parser(subparsers: Any) -> argparse.ArgumentParser:
         "train",
         help="train an SB3 baseline (PPO, SAC or HybridPPO) on a mission environment",
         description="Train ALGO on ENV_ID through the batched vector env with the settings of "
-        "baselines/hyperparameters.py (seed, budget and copies overridable), then evaluate it "
-        "and save STEM.zip, STEM.json (exact config, versions, commit, scores), "
+        "baselines/hyperparams/*.yml (rl-zoo3's format; seed, budget and copies overridable), "
+        "then evaluate it and save STEM.zip, STEM.json (exact config, versions, commit, scores), "
         "STEM_episodes.csv, STEM.png and TensorBoard logs into --output. Needs the rl extra "
         "(pip install 'mdi-envs[rl]').",
     )

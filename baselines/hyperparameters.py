@@ -1,18 +1,28 @@
-"""The one table of baseline settings, keyed by (env id, task, algorithm).
+"""The baseline settings, read from rl-zoo3 YAML files shipped in ``baselines/hyperparams``.
 
-Each entry holds the SB3 constructor arguments, the number of batched copies, the training
-budget, the seed and the environment arguments. Algorithms: SB3's PPO and SAC on the default
-flattened Box action spaces, and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a categorical
-brake x Gaussian torque policy) on the manipulator's native ``action_mode="hybrid"`` space
-``Tuple(Discrete(2), Box(-1, 1, (1,)))``. Choices shared by every entry:
+One source: the files ``hyperparams/{algo}.yml`` (task "time") and ``{algo}_{task}.yml``
+(other tasks: the diff drive's "effort") are rl-zoo3 hyperparameter files, keyed by the full
+env id, so that ``python -m rl_zoo3.train --algo ppo --env mdi_envs/BlockableManipulator-v0
+--gym-packages mdi_envs -conf baselines/hyperparams/ppo.yml`` trains with the settings that
+``mdi-envs train`` reads here (``get_hyperparameters``). rl-zoo3 looks an entry up by env id
+alone, so a task that needs other settings needs its own file; the task itself travels as the
+env argument ``task`` in ``env_kwargs``. An entry's rl-zoo3 keys map to ours: ``n_envs`` ->
+``num_envs``, ``n_timesteps`` -> ``total_timesteps``, ``normalize: {norm_obs: false,
+norm_reward: true}`` -> ``normalize_reward`` (the only normalization used), ``env_kwargs`` as
+is, ``policy`` must be ``MlpPolicy``; every other key is an SB3 constructor argument
+(``algo_kwargs``). Algorithms: SB3's PPO and SAC on the default flattened Box action spaces,
+and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a categorical brake x Gaussian torque
+policy) on the manipulator's native ``action_mode="hybrid"`` space ``Tuple(Discrete(2),
+Box(-1, 1, (1,)))``; rl-zoo3 trains it through ``baselines.zoo``. Choices shared by every
+entry:
 
 - ``gamma = 0.99`` for every algorithm. The env's shaping term is
   ``shaping_discount * Phi(s') - Phi(s)`` with Phi = -distance; every entry sets
-  ``shaping_discount = 1.0`` (``SHAPING_DISCOUNT``) except the manipulator's PPO, shipped with
-  0.99 = gamma. With 1.0 the shaping telescopes to Phi(s_T) - Phi(s_0) per episode, so the
-  episodic (undiscounted) objective is unchanged; with gamma < 1 it pays (1 - gamma) * distance
-  per step for standing still, and the gamma-shaped HybridPPO and robot "time" runs settled
-  there (0 % success at 5 x 10^6 steps) where the same settings with 1.0 reached 100 %.
+  ``shaping_discount = 1.0`` except the manipulator's PPO, shipped with 0.99 = gamma. With
+  1.0 the shaping telescopes to Phi(s_T) - Phi(s_0) per episode, so the episodic
+  (undiscounted) objective is unchanged; with gamma < 1 it pays (1 - gamma) * distance per
+  step for standing still, and the gamma-shaped HybridPPO and robot "time" runs settled there
+  (0 % success at 5 x 10^6 steps) where the same settings with 1.0 reached 100 %.
 - Diff drive "effort" PPO: ``goal_weight = 1000`` (the weight of the distance at the
   horizon's end) with ``normalize_reward`` (SB3's ``VecNormalize`` on the rewards only, during
   training; the policy never sees them). Without normalization, 5 x 10^6 steps: the env's
@@ -34,12 +44,15 @@ brake x Gaussian torque policy) on the manipulator's native ``action_mode="hybri
   there, SAC at 400-800). Episodes: manipulator up to 500 steps of 0.02 s, the optimum
   takes about 228; diff drive "time" up to 200 steps of 0.05 s, "effort" exactly 81.
   Untuned starting points: the shipped results say how far they get.
-- Seed 0 everywhere; ``train(..., seed=...)`` overrides it.
+- Seed ``DEFAULT_SEED`` = 0 (rl-zoo3 takes it from ``--seed``, not from the file);
+  ``train(..., seed=...)`` overrides it.
 """
 
 from __future__ import annotations
 
 import copy
+import functools
+from pathlib import Path
 from typing import Any
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
@@ -54,55 +67,17 @@ ALGORITHM_CLASSES = {
 """Algorithm name -> "module:class" of its SB3-compatible class (imported on use, see
 ``baselines.train.algorithm_class``; this module imports no SB3)."""
 
-_PPO: dict[str, Any] = {
-    "num_envs": 64,
-    "seed": 0,
-    "algo_kwargs": {
-        "n_steps": 256, "batch_size": 2048, "n_epochs": 10, "learning_rate": 3e-4,
-        "gamma": 0.99, "gae_lambda": 0.95, "clip_range": 0.2, "ent_coef": 0.0,
-        "max_grad_norm": 0.5,
-        "policy_kwargs": {"net_arch": {"pi": [64, 64], "vf": [64, 64]}},
-    },
-}
-_SAC: dict[str, Any] = {
-    "num_envs": 64,
-    "seed": 0,
-    "algo_kwargs": {
-        "buffer_size": 1_000_000, "batch_size": 256, "learning_rate": 3e-4, "gamma": 0.99,
-        "tau": 0.005, "learning_starts": 10_000, "train_freq": 1, "gradient_steps": 4,
-        "ent_coef": "auto", "policy_kwargs": {"net_arch": [256, 256]},
-    },
-}
+HYPERPARAMS_DIR = Path(__file__).parent / "hyperparams"
+"""The shipped rl-zoo3 hyperparameter files (package data)."""
 
-
-SHAPING_DISCOUNT = 1.0
-"""The env's ``shaping_discount`` in every entry that does not set its own."""
-
-
-def _entry(base: dict[str, Any], env_kwargs: dict[str, Any], total_timesteps: int,
-           normalize_reward: bool = False) -> dict[str, Any]:
-    return {**copy.deepcopy(base), "total_timesteps": total_timesteps,
-            "env_kwargs": {"shaping_discount": SHAPING_DISCOUNT, **env_kwargs},
-            "normalize_reward": normalize_reward}  # fmt: skip
-
-
-HYPERPARAMETERS: dict[tuple[str, str, str], dict[str, Any]] = {
-    (MANIPULATOR, "time", "PPO"): _entry(_PPO, {"shaping_discount": 0.99}, 10_000_000),
-    (MANIPULATOR, "time", "SAC"): _entry(_SAC, {}, 1_000_000),
-    (MANIPULATOR, "time", "HybridPPO"): _entry(_PPO, {"action_mode": "hybrid"}, 5_000_000),
-    (DIFF_DRIVE, "time", "PPO"): _entry(_PPO, {"task": "time"}, 4_000_000),
-    (DIFF_DRIVE, "time", "SAC"): _entry(_SAC, {"task": "time"}, 1_000_000),
-    (DIFF_DRIVE, "effort", "PPO"): _entry(_PPO, {"task": "effort", "goal_weight": 1000.0},
-                                          5_000_000, normalize_reward=True),
-    (DIFF_DRIVE, "effort", "SAC"): _entry(_SAC, {"task": "effort", "goal_weight": 100.0},
-                                          1_000_000),
-}
-"""(env id, task, algorithm) -> {"num_envs", "total_timesteps", "seed", "algo_kwargs" (SB3
-constructor arguments), "env_kwargs" (``gym.make`` arguments), "normalize_reward" (train on
-rewards scaled by ``VecNormalize``)}."""
+DEFAULT_SEED = 0
+"""The seed of a run when none is given (rl-zoo3: ``--seed 0``)."""
 
 DEFAULT_TASKS = {MANIPULATOR: "time", DIFF_DRIVE: "time"}
 """The task used when none is given (the manipulator has only "time")."""
+
+_NORMALIZE_REWARD = {"norm_obs": False, "norm_reward": True}
+"""rl-zoo3's ``normalize`` value of the entries with ``normalize_reward``."""
 
 
 def canonical_algorithm(name: str) -> str:
@@ -111,6 +86,63 @@ def canonical_algorithm(name: str) -> str:
     An unknown name is returned unchanged (the caller's lookup then reports it).
     """
     return {algo.lower(): algo for algo in ALGORITHMS}.get(name.lower(), name)
+
+
+def hyperparameter_file(algo: str, task: str = "time") -> Path:
+    """The rl-zoo3 file of ``algo``, ``task``: ``{algo}.yml`` ("time") or ``{algo}_{task}.yml``.
+
+    The path exists only for the combinations of the table (``hyperparameter_table``).
+    """
+    name = canonical_algorithm(algo).lower() + ("" if task == "time" else f"_{task}")
+    return HYPERPARAMS_DIR / f"{name}.yml"
+
+
+def entry_from_zoo(zoo: dict[str, Any]) -> dict[str, Any]:
+    """Our table entry of one rl-zoo3 YAML entry (see the module docstring for the mapping).
+
+    Raises:
+        ValueError: a ``policy`` other than ``MlpPolicy`` or an unsupported ``normalize``.
+    """
+    algo_kwargs = copy.deepcopy(zoo)
+    num_envs = int(algo_kwargs.pop("n_envs", 1))
+    total_timesteps = int(float(algo_kwargs.pop("n_timesteps")))
+    env_kwargs = algo_kwargs.pop("env_kwargs", {})
+    normalize = algo_kwargs.pop("normalize", None)
+    if algo_kwargs.pop("policy", "MlpPolicy") != "MlpPolicy":
+        raise ValueError(f"only policy MlpPolicy is supported, got {zoo['policy']!r}")
+    if normalize not in (None, _NORMALIZE_REWARD):
+        raise ValueError(f"only normalize {_NORMALIZE_REWARD} is supported, got {normalize!r}")
+    return {"num_envs": num_envs, "total_timesteps": total_timesteps, "seed": DEFAULT_SEED,
+            "algo_kwargs": algo_kwargs, "env_kwargs": env_kwargs,
+            "normalize_reward": normalize is not None}  # fmt: skip
+
+
+@functools.cache
+def hyperparameter_table() -> dict[tuple[str, str, str], dict[str, Any]]:
+    """The table read from ``HYPERPARAMS_DIR`` (once per process; the object is shared).
+
+    Returns:
+        (env id, task, algorithm) -> {"num_envs", "total_timesteps", "seed", "algo_kwargs"
+        (SB3 constructor arguments), "env_kwargs" (``gym.make`` arguments), "normalize_reward"
+        (train on rewards scaled by ``VecNormalize``)}. The algorithm is the file name's first
+        part, the task the entry's ``env_kwargs["task"]`` ("time" when absent).
+
+    Raises:
+        ValueError: an entry in a file whose name does not match its algorithm and task.
+    """
+    import yaml
+
+    table: dict[tuple[str, str, str], dict[str, Any]] = {}
+    for path in sorted(HYPERPARAMS_DIR.glob("*.yml")):
+        algo = canonical_algorithm(path.stem.split("_")[0])
+        for env_id, zoo in yaml.safe_load(path.read_text()).items():
+            entry = entry_from_zoo(zoo)
+            task = str(entry["env_kwargs"].get("task", "time"))
+            if hyperparameter_file(algo, task) != path:
+                raise ValueError(f"{path.name}: the {env_id} entry (task {task!r}) belongs in "
+                                 f"{hyperparameter_file(algo, task).name}")  # fmt: skip
+            table[(env_id, task, algo)] = entry
+    return table
 
 
 def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict[str, Any]:
@@ -124,16 +156,17 @@ def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict
     Raises:
         KeyError: no entry for this combination (the message lists the known keys).
     """
+    table = hyperparameter_table()
     task = DEFAULT_TASKS.get(env_id) if task is None else task
     key = (env_id, str(task), canonical_algorithm(algo))
-    if key not in HYPERPARAMETERS:
-        known = ", ".join(" ".join(k) for k in HYPERPARAMETERS)
+    if key not in table:
+        known = ", ".join(" ".join(k) for k in table)
         raise KeyError(f"no hyperparameters for {' '.join(map(str, key))}; known: {known}")
-    return copy.deepcopy(HYPERPARAMETERS[key])
+    return copy.deepcopy(table[key])
 
 
 __all__ = [
-    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_TASKS", "HYPERPARAMETERS", "SHAPING_DISCOUNT",
-    "canonical_algorithm",
-    "get_hyperparameters",
+    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_SEED", "DEFAULT_TASKS", "HYPERPARAMS_DIR",
+    "canonical_algorithm", "entry_from_zoo", "get_hyperparameters", "hyperparameter_file",
+    "hyperparameter_table",
 ]

@@ -49,7 +49,7 @@ def test_train_ppo_smoke_with_normalized_rewards(tmp_path: Path,
     import baselines.hyperparameters as table
     from baselines.train import train
 
-    monkeypatch.setitem(table.HYPERPARAMETERS[(MANIPULATOR, "time", "PPO")],
+    monkeypatch.setitem(table.hyperparameter_table()[(MANIPULATOR, "time", "PPO")],
                         "normalize_reward", True)  # fmt: skip
     overrides = {"n_steps": 64, "batch_size": 64, "n_epochs": 2, **TINY}
     path = train(MANIPULATOR, "ppo", seed=3, total_timesteps=1000, output=tmp_path,
@@ -70,7 +70,7 @@ def test_train_sac_smoke_through_the_cli(tmp_path: Path, capsys: pytest.CaptureF
                                          monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
     import baselines.hyperparameters as table
 
-    entry = table.HYPERPARAMETERS[(MANIPULATOR, "time", "SAC")]
+    entry = table.hyperparameter_table()[(MANIPULATOR, "time", "SAC")]
     monkeypatch.setitem(entry, "algo_kwargs", {**entry["algo_kwargs"], "learning_starts": 200,
                                                "batch_size": 32, "gradient_steps": 1,
                                                "buffer_size": 2000, **TINY})  # fmt: skip

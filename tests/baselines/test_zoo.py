@@ -1,0 +1,84 @@
+"""rl-zoo3 reads the shipped hyperparameter files as ``mdi-envs train`` does, trains and plays."""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+import mdi_envs  # noqa: F401 - registers the ids
+from baselines.hyperparameters import (
+    get_hyperparameters,
+    hyperparameter_file,
+    hyperparameter_table,
+)
+
+pytest.importorskip("rl_zoo3", reason="rl-zoo3 is in the rl extra")
+MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
+ZOO_ALGOS = {"PPO": "ppo", "SAC": "sac", "HybridPPO": "hybridppo"}
+
+
+@pytest.mark.parametrize("key", sorted(hyperparameter_table()), ids=" ".join)
+def test_rl_zoo3_resolves_our_entry(key: tuple[str, str, str]) -> None:
+    """rl-zoo3's own reader finds the env id's entry (not its "default") with our values."""
+    from rl_zoo3.exp_manager import ExperimentManager
+
+    env_id, task, algo = key
+    entry = get_hyperparameters(env_id, algo, task)
+    manager = ExperimentManager(argparse.Namespace(), ZOO_ALGOS[algo], env_id, "unused",
+                                config=str(hyperparameter_file(algo, task)))  # fmt: skip
+    hyperparams, _ = manager.read_hyperparameters()
+    model_kwargs, *_ = manager._preprocess_hyperparams(dict(hyperparams))
+    assert manager.n_envs == entry["num_envs"]
+    assert manager.n_timesteps == entry["total_timesteps"]
+    assert manager.env_kwargs == entry["env_kwargs"]
+    assert manager.normalize == entry["normalize_reward"]
+    if entry["normalize_reward"]:
+        assert manager.normalize_kwargs == {"norm_obs": False, "norm_reward": True,
+                                            "gamma": entry["algo_kwargs"]["gamma"]}  # fmt: skip
+    assert model_kwargs.pop("policy") == "MlpPolicy"
+    assert set(model_kwargs) == set(entry["algo_kwargs"])
+    resolved = {key: value(1.0) if callable(value) else value  # rl-zoo3 makes learning_rate
+                for key, value in model_kwargs.items()}  # and clip_range constant schedules
+    assert resolved == entry["algo_kwargs"]
+
+
+@pytest.mark.slow
+def test_rl_zoo3_train_uses_our_settings_and_enjoy_plays(tmp_path: Path) -> None:
+    """The README's command, ``-n 2000`` (one 64 x 256 rollout), then ``rl_zoo3.enjoy``."""
+    conf = hyperparameter_file("PPO")
+    common = ["--algo", "ppo", "--env", MANIPULATOR, "--gym-packages", "mdi_envs",
+              "-f", str(tmp_path)]  # fmt: skip
+    subprocess.run([sys.executable, "-m", "rl_zoo3.train", *common, "-conf", str(conf),
+                    "-n", "2000", "--seed", "0", "--num-threads", "1"],
+                   check=True, capture_output=True, text=True)  # fmt: skip
+    run = tmp_path / "ppo" / "mdi_envs-BlockableManipulator-v0_1"
+    saved = yaml.unsafe_load((run / "mdi_envs-BlockableManipulator-v0" / "config.yml").read_text())
+    zoo = yaml.safe_load(conf.read_text())[MANIPULATOR]
+    assert dict(saved) == zoo  # rl-zoo3's record of the settings it trained with
+    assert (run / "mdi_envs-BlockableManipulator-v0.zip").exists()
+    played = subprocess.run([sys.executable, "-m", "rl_zoo3.enjoy", *common, "-n", "600",
+                             "--no-render", "--deterministic"],
+                            check=True, capture_output=True, text=True).stdout  # fmt: skip
+    assert "Episode Length 500" in played  # the untrained arm times out
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:Training and eval env are not of the same type")
+def test_hybrid_ppo_through_the_zoo_launcher(tmp_path: Path) -> None:
+    """``python -m baselines.zoo train --algo hybridppo`` (shrunk rollout) and ``enjoy``."""
+    from baselines.zoo import main
+
+    common = ["--algo", "hybridppo", "--env", MANIPULATOR, "--gym-packages", "mdi_envs",
+              "-f", str(tmp_path)]  # fmt: skip
+    main(["train", *common, "-conf", str(hyperparameter_file("HybridPPO")), "-n", "256",
+          "--seed", "0", "-params", "n_envs:2", "n_steps:64", "batch_size:64", "n_epochs:1"])
+    assert (tmp_path / "hybridppo" / "mdi_envs-BlockableManipulator-v0_1"
+            / "mdi_envs-BlockableManipulator-v0.zip").exists()  # fmt: skip
+    main(["enjoy", *common, "-n", "50", "--no-render"])
+    with pytest.raises(SystemExit, match="usage"):
+        main(["play"])
