@@ -1,0 +1,177 @@
+"""PPO training throughput through the batched adapter vs SB3's DummyVecEnv and SubprocVecEnv.
+
+The same PPO (the shipped settings of ``baselines/hyperparams/ppo.yml``: 64 copies, rollouts of
+64 x 256 steps, 10 epochs, torch on one thread) trains for ``--rollouts`` rollouts on one env
+id through three vector envs of ``--num-envs`` copies:
+
+- ``batched adapter``: ``baselines.vec_env.make_vec_env`` (one compiled call steps every copy)
+  in ``VecMonitor``, what ``mdi-envs train`` uses;
+- ``DummyVecEnv``: SB3's ``make_vec_env`` over ``gym.make`` copies (each in ``Monitor``), what
+  ``python -m rl_zoo3.train`` uses by default;
+- ``SubprocVecEnv``: the same copies, one worker process each (``--vec-env subproc`` in
+  rl-zoo3), started by ``fork`` so that the 64 workers need no interpreter start-up or import
+  of their own (the default ``forkserver`` would import torch and the env in each).
+
+Per vector env: the set-up time (creating the copies, workers included), the training time and
+environment steps per second over it, and its split into rollout collection (env steps and
+policy inference; steps per second) and PPO updates (a callback times each rollout).
+
+Writes ``vec_env_throughput.json`` and ``vec_env_throughput.png`` into ``--output`` and prints
+a Markdown table. ``python -m benchmarks.vec_env_throughput`` (manipulator, 64 copies,
+20 rollouts = 327,680 steps each): about 3 min on 2 cores. Needs the ``rl`` extra.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks.timing import Progress, machine_info
+
+BACKENDS = ("batched adapter", "DummyVecEnv", "SubprocVecEnv")
+"""The vector envs compared, in the order they run."""
+
+
+def make_backend(backend: str, env_id: str, num_envs: int, env_kwargs: dict[str, Any]) -> Any:
+    """An SB3 ``VecEnv`` of ``num_envs`` copies of ``env_id`` through ``backend``."""
+    from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecMonitor
+
+    from baselines.vec_env import make_vec_env
+
+    if backend == "batched adapter":
+        return VecMonitor(make_vec_env(env_id, num_envs, **env_kwargs))
+    if backend == "DummyVecEnv":
+        return sb3_make_vec_env(env_id, num_envs, seed=0, env_kwargs=env_kwargs,
+                                vec_env_cls=DummyVecEnv)  # fmt: skip
+    if backend == "SubprocVecEnv":
+        return sb3_make_vec_env(env_id, num_envs, seed=0, env_kwargs=env_kwargs,
+                                vec_env_cls=SubprocVecEnv,
+                                vec_env_kwargs={"start_method": "fork"})  # fmt: skip
+    raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
+
+
+def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str, Any]:
+    """Train PPO for ``rollouts`` rollouts through ``backend``; times [s] and steps per second.
+
+    Returns:
+        {"backend", "setup_s", "train_s", "timesteps", "train_steps_per_s", "rollout_s",
+        "rollout_steps_per_s", "update_s"}.
+    """
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from baselines.hyperparameters import get_hyperparameters
+
+    class RolloutTimer(BaseCallback):
+        def __init__(self) -> None:
+            super().__init__()
+            self.rollout_s = 0.0
+            self._start = 0.0
+
+        def _on_rollout_start(self) -> None:
+            self._start = time.perf_counter()
+
+        def _on_rollout_end(self) -> None:
+            self.rollout_s += time.perf_counter() - self._start
+
+        def _on_step(self) -> bool:
+            return True
+
+    torch.set_num_threads(1)
+    entry = get_hyperparameters(env_id, "PPO")
+    start = time.perf_counter()
+    venv = make_backend(backend, env_id, num_envs, entry["env_kwargs"])
+    if entry["normalize_reward"]:
+        venv = VecNormalize(venv, norm_obs=False, norm_reward=True,
+                            gamma=entry["algo_kwargs"]["gamma"])  # fmt: skip
+    setup_s = time.perf_counter() - start
+    model = PPO("MlpPolicy", venv, seed=0, device="cpu", **entry["algo_kwargs"])
+    timer = RolloutTimer()
+    start = time.perf_counter()
+    model.learn(total_timesteps=rollouts * model.n_steps * num_envs, callback=timer)
+    train_s = time.perf_counter() - start
+    venv.close()
+    timesteps = int(model.num_timesteps)
+    return {"backend": backend, "setup_s": setup_s, "train_s": train_s, "timesteps": timesteps,
+            "train_steps_per_s": timesteps / train_s, "rollout_s": timer.rollout_s,
+            "rollout_steps_per_s": timesteps / timer.rollout_s,
+            "update_s": train_s - timer.rollout_s}  # fmt: skip
+
+
+def markdown(results: Sequence[dict[str, Any]]) -> str:
+    """One row per vector env, with its speed relative to the batched adapter's."""
+    reference = results[0]["train_steps_per_s"]
+    lines = ["| vector env | set-up [s] | training [steps/s] | vs adapter | rollouts "
+             "[steps/s] | updates [s] |", "|---|---|---|---|---|---|"]  # fmt: skip
+    for r in results:
+        lines.append(f"| {r['backend']} | {r['setup_s']:.1f} | {r['train_steps_per_s']:,.0f} | "
+                     f"{r['train_steps_per_s'] / reference:.2f}x | "
+                     f"{r['rollout_steps_per_s']:,.0f} | {r['update_s']:.1f} |")  # fmt: skip
+    return "\n".join(lines)
+
+
+def plot(record: dict[str, Any], path: Path) -> None:
+    """Bars: training and rollout steps per second per vector env."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    results = record["results"]
+    positions = np.arange(len(results))
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.bar(positions - 0.2, [r["train_steps_per_s"] for r in results], 0.4, color="C0",
+           label="training (rollouts + updates)")  # fmt: skip
+    ax.bar(positions + 0.2, [r["rollout_steps_per_s"] for r in results], 0.4, color="C1",
+           label="rollout collection only")  # fmt: skip
+    ax.set_xticks(positions, [r["backend"] for r in results])
+    ax.set_ylabel("environment steps / s")
+    ax.set_title(f"PPO on {record['env_id'].split('/')[-1]}, {record['num_envs']} copies, "
+                 f"{record['results'][0]['timesteps']:,} steps each")  # fmt: skip
+    ax.legend()
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Measure every backend, write the JSON and PNG, print the table; returns 0."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.vec_env_throughput",
+                                     description=__doc__.split("\n")[0])  # fmt: skip
+    parser.add_argument("--env-id", default="mdi_envs/BlockableManipulator-v0")
+    parser.add_argument("--num-envs", type=int, default=64)
+    parser.add_argument("--rollouts", type=int, default=20, help="PPO rollouts per vector env")
+    parser.add_argument("--backends", nargs="+", choices=BACKENDS, default=list(BACKENDS))
+    parser.add_argument("--output", type=Path, default=Path("benchmarks/results"))
+    args = parser.parse_args(argv)
+    say = Progress()
+    record: dict[str, Any] = {"machine": machine_info(), "env_id": args.env_id,
+                              "num_envs": args.num_envs, "rollouts": args.rollouts,
+                              "command": " ".join(["python -m benchmarks.vec_env_throughput",
+                                                   *(argv if argv is not None else sys.argv[1:])]),
+                              "results": []}  # fmt: skip
+    for backend in args.backends:
+        say(f"{backend}: {args.num_envs} copies, {args.rollouts} PPO rollouts")
+        result = measure(backend, args.env_id, args.num_envs, args.rollouts)
+        say(f"{backend}: {result['train_steps_per_s']:,.0f} steps/s")
+        record["results"].append(result)
+    args.output.mkdir(parents=True, exist_ok=True)
+    (args.output / "vec_env_throughput.json").write_text(json.dumps(record, indent=1) + "\n")
+    plot(record, args.output / "vec_env_throughput.png")
+    print(markdown(record["results"]))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
