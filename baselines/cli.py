@@ -84,17 +84,28 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
 
     parser = subparsers.add_parser(
         "compare",
-        help="shipped RL policies vs the optimal reference: success, time and effort ratios",
-        description="Play every shipped policy (baselines/trained) of ENV_ID and the optimal "
-        "reference (open loop) from the nominal start and from --seeds perturbed starts; print "
-        "success rates and time/effort ratios to the optimum as a Markdown table; write "
-        "compare_ENV_TASK.json and .png (trajectories, brake schedules / slip modes, scores) "
-        "and compare.md into --output. ENV_ID 'all' runs both mission envs, every task.",
+        help="trained RL policies (every seed) vs the optimal reference: IQM and CIs of success, "
+        "time and effort ratios",
+        description="Play every trained policy of ENV_ID (--trained, default baselines/trained: "
+        "one STEM.json + STEM.zip per training seed) and the untrained controllers (the optimal "
+        "reference, open loop) from the nominal start and from --seeds perturbed starts; print "
+        "per algorithm the IQM and 95 % stratified-bootstrap CI over its seeds (rliable) of the "
+        "success rate and of the time/effort ratios to the optimum as a Markdown table; write "
+        "compare_ENV_TASK.json and .png (trajectories, brake schedules / slip modes, scores), "
+        "seeds_ENV_TASK.png (performance profiles, training curves with CI bands from the "
+        "STEM_episodes.csv files) and compare.md into --output. ENV_ID 'all' runs both mission "
+        "envs, every task.",
     )
     parser.add_argument("env_id", choices=[*sorted(TASKS), "all"], help="the environment")
     parser.add_argument("--task", choices=("time", "effort"), default=None,
                         help="one task (default: every task of the env)")
-    parser.add_argument("--seeds", type=int, default=20, help="perturbed starts per controller")
+    parser.add_argument("--seeds", type=int, default=20,
+                        help="perturbed starts per run (per training seed and controller)")
+    parser.add_argument("--trained", type=Path, default=None,
+                        help="folder of the trained policies (default: baselines/trained; e.g. "
+                        "the output of mdi-envs sweep)")
+    parser.add_argument("--bootstrap-reps", type=int, default=None,
+                        help="bootstrap replications per CI (default 2000)")
     parser.add_argument("--output", type=Path, default=Path("results/compare"),
                         help="folder for the JSON, PNG and Markdown results")
     parser.set_defaults(handler=run_compare)
@@ -105,7 +116,7 @@ def run_compare(args: argparse.Namespace) -> int:
     """Handler of ``compare``: runs each env x task, prints and writes the table; returns 0."""
     import sys
 
-    from baselines.compare import TASKS, compare, markdown_table, write_comparison
+    from baselines.compare import TASKS, TRAINED_DIR, compare, markdown_table, write_comparison
 
     if args.seeds < 1:
         raise SystemExit(f"compare: --seeds must be >= 1, got {args.seeds}")
@@ -114,11 +125,13 @@ def run_compare(args: argparse.Namespace) -> int:
             if args.task in (None, task)]  # fmt: skip
     if not jobs:
         raise SystemExit(f"compare: {args.env_id} has no task {args.task!r}")
+    trained_dir = TRAINED_DIR if args.trained is None else args.trained
     comparisons = []
     for env_id, task in jobs:
-        comparison = compare(env_id, task, num_seeds=args.seeds,
+        comparison = compare(env_id, task, num_seeds=args.seeds, trained_dir=trained_dir,
+                             bootstrap_reps=args.bootstrap_reps,
                              log=lambda line: print(line, file=sys.stderr, flush=True))
-        for path in write_comparison(comparison, args.output):
+        for path in write_comparison(comparison, args.output, trained_dir):
             print(f"wrote {path}", file=sys.stderr)
         comparisons.append(comparison)
     table = markdown_table(comparisons)

@@ -1,33 +1,40 @@
-"""RL policies against the optimal reference in the same environment, over many seeds.
+"""RL policies against the optimal reference in the same environment, over training seeds.
 
-``compare("mdi_envs/DiffDriveRobot-v0", "effort")`` plays every shipped policy of that env and
-task (``baselines/trained/*.zip`` with its JSON config), deterministically, from ``reset(seed=s)``
-for the seeds ``0 ... num_seeds - 1``: each reset draws a small start perturbation (the env's
-``reset_noise_scale``, 0.01 rad, rad/s or m, m/s by default). The optimal reference
-(``optimal/references``) is played open loop through the same environment id, configured so that
-one env step is one interval of the transcription (``optimal.replay.env_options``): once from the
-nominal start (its ratio is 1 by construction) and from the same perturbed starts.
+``compare("mdi_envs/DiffDriveRobot-v0", "effort")`` plays every trained policy of that env and
+task (``baselines/trained/STEM.zip`` with its ``STEM.json`` config; one per training seed,
+``{env}_{task}_{algo}_seed{S}``), deterministically, from ``reset(seed=s)`` for the starts
+``0 ... num_seeds - 1``: each reset draws a small start perturbation (the env's
+``reset_noise_scale``, 0.01 rad, rad/s or m, m/s by default). The controllers that are not
+trained (``CONTROLLER_FACTORIES``: the optimal reference, played open loop through the same env
+id with one env step per interval of the transcription, ``optimal.replay.env_options``; room
+for more, e.g. a model-based MPC) are played from the nominal start and the same starts.
 
-Scores, per controller: the success rate, and over the successful episodes the time to the goal
-[s] and the effort (integral of the squared torques [N^2 m^2 s]) as ratios to the optimum's
-(``reference.final_time`` and the reference's effort). Time to the goal is the episode's
-``elapsed_time`` when it terminates at the goal ("time" tasks) or its fixed horizon ("effort").
+Scores of one run (one training seed, or a controller): the success rate over the perturbed
+starts, and over its successful episodes the time to the goal [s] and the effort (integral of
+the squared torques [N^2 m^2 s]) as ratios to the optimum's (``reference.final_time`` and the
+reference's effort). Time to the goal is the episode's ``elapsed_time`` when it terminates at
+the goal ("time" tasks) or its fixed horizon ("effort"). Per algorithm, over its runs
+(``baselines.aggregate``, rliable): the interquartile mean and 95 % stratified-bootstrap
+confidence interval of each score; one run is reported as n=1 without interval.
 
-Outputs (``write_comparison``): ``compare_{env}_{task}.json`` (every episode's scores, the
-summaries, the reference's metadata), ``compare_{env}_{task}.png`` (the nominal trajectories of
-every controller over the optimum's, with brake schedules or slip modes) and the Markdown table
-``markdown_table`` prints.
+Outputs (``write_comparison``): ``compare_{env}_{task}.json`` (every run's episodes, summaries
+and aggregates, the reference's metadata), ``compare_{env}_{task}.png`` (the nominal
+trajectories of every controller over the optimum's, with brake schedules or slip modes, and
+the scores), ``seeds_{env}_{task}.png`` (performance profiles over runs and training curves
+with CI bands, ``baselines.seed_plots``) and the Markdown table ``markdown_table`` prints.
 """
 
 from __future__ import annotations
 
+import importlib
 import json
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 from mdi_envs.rollout import Policy, open_loop_policy, rollout
@@ -54,6 +61,33 @@ SCHEDULE_KEYS = {"mdi_envs/BlockableManipulator-v0": "brake_engaged",
 
 OPTIMAL = "optimal (open loop)"
 """The label of the reference in tables and plots."""
+
+SCORES = ("success_rate", "time_ratio", "effort_ratio")
+"""The per-run scores aggregated over runs (``summarize`` keys)."""
+
+
+@dataclass(frozen=True)
+class Controller:
+    """A controller that is not trained (no seeds: one run per comparison).
+
+    Attributes:
+        label: its row in tables and plots.
+        make_policy: called once per episode with a ``gym.make(env_id, **env_kwargs)`` of the
+            played configuration (a separate instance, e.g. to read the model and ``dt``);
+            returns the policy ``obs -> action`` for that episode.
+        env_kwargs: the ``gym.make`` arguments it is played with (``reset_noise_scale`` is set
+            by the comparison).
+    """
+
+    label: str
+    make_policy: Callable[[gym.Env[Any, Any]], Policy]
+    env_kwargs: dict[str, Any] = field(default_factory=dict)
+
+
+CONTROLLER_FACTORIES = ("baselines.compare:optimal_controller",)
+"""The untrained controller rows, as "module:function" (imported on use); each function takes
+(env id, task) and returns a ``Controller``, or None where it does not apply. A model-based
+controller (e.g. an MPC in ``optimal/``) joins every comparison by adding its entry here."""
 
 
 @dataclass
@@ -87,16 +121,20 @@ class Episode:
                 if key not in ("time", "q", "schedule")}  # fmt: skip
 
 
-def play(env_id: str, make_policy: Callable[[], Policy], seed: int, perturbed: bool,
-         **env_kwargs: Any) -> Episode:  # fmt: skip
+def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: int,
+         perturbed: bool, **env_kwargs: Any) -> Episode:  # fmt: skip
     """One episode of ``gym.make(env_id, **env_kwargs)`` from ``reset(seed=seed)``.
 
-    ``make_policy()`` is called once per episode (open-loop policies keep a step counter);
-    ``perturbed=False`` sets ``reset_noise_scale = 0`` (the nominal start).
+    ``make_policy(env)`` is called once per episode (open-loop policies keep a step counter)
+    with a separate env of the same configuration; ``perturbed=False`` sets
+    ``reset_noise_scale = 0`` (the nominal start).
     """
     if not perturbed:
         env_kwargs = {**env_kwargs, "reset_noise_scale": 0.0}
-    result = rollout(env_id, make_policy(), seed=seed, **env_kwargs)
+    env = gym.make(env_id, **env_kwargs)
+    policy = make_policy(env)
+    env.close()
+    result = rollout(env_id, policy, seed=seed, **env_kwargs)
     info = result.last_info
     dt = float(info["elapsed_time"]) / max(result.num_steps, 1)
     key = SCHEDULE_KEYS.get(env_id)
@@ -111,8 +149,8 @@ def play(env_id: str, make_policy: Callable[[], Policy], seed: int, perturbed: b
     )
 
 
-def reference_controller(reference: Reference) -> tuple[Callable[[], Policy], dict[str, Any]]:
-    """The reference's controls as an open-loop policy factory and its ``gym.make`` arguments.
+def reference_controller(reference: Reference, label: str = OPTIMAL) -> Controller:
+    """The reference's controls as an open-loop ``Controller``.
 
     One env step is one interval of the transcription (``optimal.replay.env_options``); the
     start perturbation is the env's default (``reset_noise_scale`` is left to the caller).
@@ -120,7 +158,24 @@ def reference_controller(reference: Reference) -> tuple[Callable[[], Policy], di
     actions = env_actions(reference)
     options = env_options(reference)
     options.pop("reset_noise_scale")
-    return (lambda: open_loop_policy(actions)), options
+    return Controller(label, lambda _env: open_loop_policy(actions), options)
+
+
+def optimal_controller(env_id: str, task: str) -> Controller | None:
+    """The optimal reference of (env id, task) played open loop; None without a reference."""
+    name = REFERENCE_NAMES.get((env_id, task))
+    return None if name is None else reference_controller(load_reference(name))
+
+
+def registered_controllers(env_id: str, task: str) -> list[Controller]:
+    """The ``CONTROLLER_FACTORIES`` controllers that apply to (env id, task), in order."""
+    controllers = []
+    for target in CONTROLLER_FACTORIES:
+        module, _, function = target.partition(":")
+        controller = getattr(importlib.import_module(module), function)(env_id, task)
+        if controller is not None:
+            controllers.append(controller)
+    return controllers
 
 
 def reference_effort(reference: Reference) -> float:
@@ -139,8 +194,17 @@ def shipped_policies(env_id: str, task: str, directory: Path = TRAINED_DIR) -> l
     return configs
 
 
-def load_policy(config_path: Path) -> tuple[Callable[[], Policy], dict[str, Any], dict[str, Any]]:
-    """A trained policy (deterministic ``predict``), its ``gym.make`` arguments and its config."""
+def group_by_algorithm(configs: Sequence[Path]) -> dict[str, list[Path]]:
+    """Trained-policy configs grouped by algorithm, each group sorted by seed."""
+    groups: dict[str, list[tuple[int, Path]]] = {}
+    for path in configs:
+        config = json.loads(Path(path).read_text())
+        groups.setdefault(config["algo"], []).append((int(config["seed"]), Path(path)))
+    return {algo: [path for _, path in sorted(runs)] for algo, runs in groups.items()}
+
+
+def load_policy(config_path: Path) -> tuple[Controller, dict[str, Any]]:
+    """A trained policy (deterministic ``predict``) as a ``Controller``, and its config."""
     from baselines.train import algorithm_class
 
     config = json.loads(Path(config_path).read_text())
@@ -150,7 +214,7 @@ def load_policy(config_path: Path) -> tuple[Callable[[], Policy], dict[str, Any]
     def act(obs: Any) -> Any:
         return model.predict(obs, deterministic=True)[0]
 
-    return (lambda: act), dict(config["env_kwargs"]), config
+    return Controller(config["algo"], lambda _env: act, dict(config["env_kwargs"])), config
 
 
 def summarize(episodes: Sequence[Episode], optimal_time: float, optimal_effort: float
@@ -177,13 +241,23 @@ def summarize(episodes: Sequence[Episode], optimal_time: float, optimal_effort: 
     }
 
 
-def evaluate_controller(env_id: str, make_policy: Callable[[], Policy], env_kwargs: dict[str, Any],
-                        seeds: Sequence[int]) -> tuple[Episode, list[Episode]]:  # fmt: skip
+def aggregate_runs(runs: Sequence[dict[str, Any]], reps: int | None = None) -> dict[str, Any]:
+    """Per score of ``SCORES``: IQM and 95 % CI over the runs' summaries (``iqm_interval``)."""
+    from baselines.aggregate import BOOTSTRAP_REPS, iqm_interval
+
+    return {score: iqm_interval([run["summary"][score] for run in runs],
+                                reps=BOOTSTRAP_REPS if reps is None else reps)
+            for score in SCORES}  # fmt: skip
+
+
+def evaluate_controller(env_id: str, controller: Controller, seeds: Sequence[int]
+                        ) -> tuple[Episode, list[Episode]]:  # fmt: skip
     """The nominal episode (no start noise, seed 0) and one perturbed episode per seed."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        nominal = play(env_id, make_policy, 0, False, **env_kwargs)
-        perturbed = [play(env_id, make_policy, int(seed), True, **env_kwargs) for seed in seeds]
+        nominal = play(env_id, controller.make_policy, 0, False, **controller.env_kwargs)
+        perturbed = [play(env_id, controller.make_policy, int(seed), True,
+                          **controller.env_kwargs) for seed in seeds]  # fmt: skip
     return nominal, perturbed
 
 
@@ -192,24 +266,30 @@ def compare(
     task: str,
     num_seeds: int = 20,
     policies: Sequence[Path] | None = None,
-    extra_controllers: dict[str, tuple[Callable[[], Policy], dict[str, Any]]] | None = None,
+    extra_controllers: Sequence[Controller] = (),
     log: Callable[[str], None] | None = None,
+    trained_dir: Path = TRAINED_DIR,
+    bootstrap_reps: int | None = None,
 ) -> dict[str, Any]:
-    """Evaluate the optimal reference and the policies of (env id, task) on the same seeds.
+    """Evaluate the controllers and every run of every trained algorithm on the same starts.
 
     Args:
         env_id: a mission environment id. task: "time" or "effort".
-        num_seeds: perturbed starts per controller (seeds 0 ... num_seeds - 1).
-        policies: trained-policy JSON configs (default: ``shipped_policies(env_id, task)``).
-        extra_controllers: more controllers, label -> (policy factory, ``gym.make`` arguments)
-            (tests use the random policy and the reference's own controls).
+        num_seeds: perturbed starts per run (seeds 0 ... num_seeds - 1).
+        policies: trained-policy JSON configs (default: ``shipped_policies(env_id, task,
+            trained_dir)``), one run each, grouped by algorithm.
+        extra_controllers: more untrained controllers after the registered ones
+            (``CONTROLLER_FACTORIES``; tests use a random policy and the reference's controls).
         log: progress lines (default: none).
+        trained_dir: where ``shipped_policies`` looks.
+        bootstrap_reps: bootstrap replications (default ``baselines.aggregate.BOOTSTRAP_REPS``).
 
     Returns:
         {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort" [N^2 m^2 s],
-        "seeds", "controllers": [{"label", "algo", "config", "summary", "nominal",
-        "episodes"}]}, the episodes as ``Episode`` objects (``write_comparison`` turns them
-        into JSON).
+        "seeds", "controllers": [{"label", "algo", "trained" (bool), "runs": [{"seed"
+        (training seed, None for an untrained controller), "config", "summary", "nominal",
+        "episodes"}], "aggregate": {score: ``iqm_interval``}}]}, the episodes as ``Episode``
+        objects (``write_comparison`` turns them into JSON).
     """
     if (env_id, task) not in REFERENCE_NAMES:
         known = ", ".join(f"{e} {t}" for e, t in REFERENCE_NAMES)
@@ -218,54 +298,93 @@ def compare(
     reference = load_reference(REFERENCE_NAMES[(env_id, task)])
     optimal_time, optimal_effort = reference.final_time, reference_effort(reference)
     seeds = list(range(num_seeds))
-    controllers: list[tuple[str, str, dict[str, Any], Callable[[], Policy], dict[str, Any]]] = []
-    factory, options = reference_controller(reference)
-    controllers.append((OPTIMAL, "optimal", {}, factory, options))
-    for path in shipped_policies(env_id, task) if policies is None else policies:
-        factory, options, config = load_policy(path)
-        controllers.append((config["algo"], config["algo"], config, factory, options))
-    for label, (factory, options) in (extra_controllers or {}).items():
-        controllers.append((label, label, {}, factory, options))
-    results = []
-    for label, algo, config, factory, options in controllers:
-        say(f"{env_id} {task}: {label}, nominal start + {num_seeds} perturbed starts")
-        nominal, episodes = evaluate_controller(env_id, factory, options, seeds)
-        summary = summarize(episodes, optimal_time, optimal_effort)
-        results.append({"label": label, "algo": algo, "config": config, "summary": summary,
-                        "nominal": nominal, "episodes": episodes})  # fmt: skip
+    configs = shipped_policies(env_id, task, trained_dir) if policies is None else policies
+    groups: list[tuple[str, bool, list[tuple[Controller, dict[str, Any]]]]] = [
+        (c.label, False, [(c, {})]) for c in registered_controllers(env_id, task)]
+    for algo, paths in group_by_algorithm(configs).items():
+        groups.append((algo, True, [load_policy(path) for path in paths]))
+    groups += [(c.label, False, [(c, {})]) for c in extra_controllers]
+    rows = []
+    for label, trained, members in groups:
+        runs = []
+        for controller, config in members:
+            seed = config.get("seed")
+            say(f"{env_id} {task}: {label}" + (f" seed {seed}" if trained else "")
+                + f", nominal start + {num_seeds} perturbed starts")  # fmt: skip
+            nominal, episodes = evaluate_controller(env_id, controller, seeds)
+            runs.append({"seed": seed, "config": config, "nominal": nominal,
+                         "episodes": episodes,
+                         "summary": summarize(episodes, optimal_time, optimal_effort)})  # fmt: skip
+        rows.append({"label": label, "algo": label if trained else "controller",
+                     "trained": trained, "runs": runs,
+                     "aggregate": aggregate_runs(runs, bootstrap_reps)})  # fmt: skip
     return {"env_id": env_id, "task": task, "reference": reference.name,
             "optimal_time": optimal_time, "optimal_effort": optimal_effort, "seeds": seeds,
-            "controllers": results}  # fmt: skip
+            "controllers": rows}  # fmt: skip
 
 
-def budget_text(config: dict[str, Any]) -> str:
-    """A policy's training budget, e.g. "10^7 steps, 64 envs, seed 0" ("" for the optimum)."""
-    if not config:
+def budget_text(row: dict[str, Any]) -> str:
+    """A row's training budget and seeds, e.g. "10^7 steps, 64 envs, seeds 0-4" ("" untrained)."""
+    if not row["trained"]:
         return ""
-    steps = int(config.get("num_timesteps", config.get("total_timesteps", 0)))
-    return f"{steps:.2g} steps, {config.get('num_envs')} envs, seed {config.get('seed')}"
+    configs = [run["config"] for run in row["runs"]]
+    steps = {int(c.get("num_timesteps", c.get("total_timesteps", 0))) for c in configs}
+    seeds = sorted(int(c["seed"]) for c in configs)
+    seed_text = (f"seed {seeds[0]}" if len(seeds) == 1 else
+                 f"seeds {seeds[0]}-{seeds[-1]}" if seeds == list(range(seeds[0], seeds[-1] + 1))
+                 else "seeds " + ",".join(map(str, seeds)))  # fmt: skip
+    budget = "/".join(sorted({f"{s:.2g}" for s in steps}))
+    return f"{budget} steps, {configs[0].get('num_envs')} envs, {seed_text}"
 
 
-def _ratio(value: float | None) -> str:
-    return "-" if value is None else f"{value:.2f}"
+def interval_text(estimate: dict[str, Any], percent: bool = False) -> str:
+    """"IQM [low, high] (n=k)", "value (n=1, no CI)" or "-" (no run with a score)."""
+    if estimate["iqm"] is None:
+        return "-"
+    show = (lambda v: f"{100 * v:.0f} %") if percent else (lambda v: f"{v:.2f}")
+    missing = f", {estimate['missing']} without" if estimate["missing"] else ""
+    if estimate["ci"] is None:
+        return f"{show(estimate['iqm'])} (n={estimate['n']}, no CI{missing})"
+    low, high = estimate["ci"]
+    return f"{show(estimate['iqm'])} [{show(low)}, {show(high)}] (n={estimate['n']}{missing})"
+
+
+def _nominal_text(row: dict[str, Any]) -> str:
+    if row["trained"]:
+        wins = sum(run["nominal"].is_success for run in row["runs"])
+        return f"{wins} of {len(row['runs'])} runs succeed"
+    nominal = row["runs"][0]["nominal"]
+    return (f"success, {nominal.elapsed_time:.2f} s, effort {nominal.effort:.3g}"
+            if nominal.is_success else "fails")  # fmt: skip
 
 
 def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
-    """One row per env x task x controller: success, ratios to the optimum, nominal run."""
-    lines = ["| env | task | controller | success (perturbed starts) | time / optimal | "
-             "effort / optimal | nominal start | training budget |",
-             "|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    """One row per env x task x controller: IQM [95 % CI] over runs (n) of each score.
+
+    A trained algorithm's runs are its training seeds; an untrained controller is one run
+    (its cells show the value alone, "(controller)").
+    """
+    lines = ["| env | task | controller | runs | success (perturbed starts), IQM [95 % CI] | "
+             "time / optimal | effort / optimal | nominal start | training budget |",
+             "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for comparison in comparisons:
         env = comparison["env_id"].split("/")[-1]
+        starts = len(comparison["seeds"])
         for row in comparison["controllers"]:
-            s, nominal = row["summary"], row["nominal"]
-            nominal_text = (f"success, {nominal.elapsed_time:.2f} s, effort {nominal.effort:.3g}"
-                            if nominal.is_success else "fails")  # fmt: skip
-            lines.append(
-                f"| {env} | {comparison['task']} | {row['label']} | "
-                f"{s['success_rate']:.0%} of {s['episodes']} | {_ratio(s['time_ratio'])} | "
-                f"{_ratio(s['effort_ratio'])} | {nominal_text} | {budget_text(row['config'])} |"
-            )
+            aggregate = row["aggregate"]
+            if row["trained"]:
+                runs = f"{len(row['runs'])} seeds x {starts} starts"
+                cells = [interval_text(aggregate["success_rate"], percent=True),
+                         interval_text(aggregate["time_ratio"]),
+                         interval_text(aggregate["effort_ratio"])]  # fmt: skip
+            else:
+                runs = f"controller, {starts} starts"
+                cells = [f"{100 * aggregate['success_rate']['iqm']:.0f} %",
+                         *(f"{v['iqm']:.2f}" if v["iqm"] is not None else "-"
+                           for v in (aggregate["time_ratio"], aggregate["effort_ratio"]))]
+            lines.append(f"| {env} | {comparison['task']} | {row['label']} | {runs} | "
+                         + " | ".join(cells)
+                         + f" | {_nominal_text(row)} | {budget_text(row)} |")  # fmt: skip
     return "\n".join(lines)
 
 
@@ -273,31 +392,46 @@ def comparison_record(comparison: dict[str, Any]) -> dict[str, Any]:
     """The comparison as plain JSON (episodes as their scores, no trajectories)."""
     record = {k: v for k, v in comparison.items() if k != "controllers"}
     record["controllers"] = [
-        {"label": row["label"], "algo": row["algo"], "config": row["config"],
-         "summary": row["summary"], "nominal": row["nominal"].scores(),
-         "episodes": [e.scores() for e in row["episodes"]]}
+        {"label": row["label"], "algo": row["algo"], "trained": row["trained"],
+         "aggregate": row["aggregate"],
+         "runs": [{"seed": run["seed"], "config": run["config"], "summary": run["summary"],
+                   "nominal": run["nominal"].scores(),
+                   "episodes": [e.scores() for e in run["episodes"]]}
+                  for run in row["runs"]]}
         for row in comparison["controllers"]
     ]  # fmt: skip
     return record
 
 
-def write_comparison(comparison: dict[str, Any], output: Path) -> list[Path]:
-    """Write ``compare_{env}_{task}.json`` and ``.png`` into ``output``; returns their paths."""
+def write_comparison(comparison: dict[str, Any], output: Path,
+                     trained_dir: Path = TRAINED_DIR) -> list[Path]:  # fmt: skip
+    """Write ``compare_{env}_{task}.json``, its ``.png`` and ``seeds_{env}_{task}.png``.
+
+    The training curves of ``seeds_*.png`` come from the runs' ``STEM_episodes.csv`` in
+    ``trained_dir`` where present.
+
+    Returns:
+        The written paths.
+    """
     from baselines.compare_plots import plot_comparison
+    from baselines.seed_plots import plot_seeds
 
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)
-    stem = f"compare_{comparison['env_id'].split('/')[-1]}_{comparison['task']}"
-    json_path = output / f"{stem}.json"
+    stem = f"{comparison['env_id'].split('/')[-1]}_{comparison['task']}"
+    json_path = output / f"compare_{stem}.json"
     json_path.write_text(json.dumps(comparison_record(comparison), indent=1, default=str) + "\n")
-    png_path = output / f"{stem}.png"
+    png_path = output / f"compare_{stem}.png"
     plot_comparison(comparison, png_path)
-    return [json_path, png_path]
+    seeds_path = output / f"seeds_{stem}.png"
+    plot_seeds(comparison, seeds_path, trained_dir)
+    return [json_path, png_path, seeds_path]
 
 
 __all__ = [
-    "OPTIMAL", "REFERENCE_NAMES", "TASKS", "TRAINED_DIR", "Episode",
-    "compare", "comparison_record", "evaluate_controller", "load_policy", "markdown_table",
-    "play", "reference_controller", "reference_effort", "shipped_policies", "summarize",
-    "write_comparison",
+    "CONTROLLER_FACTORIES", "OPTIMAL", "REFERENCE_NAMES", "SCORES", "TASKS", "TRAINED_DIR",
+    "Controller", "Episode", "aggregate_runs", "compare", "comparison_record",
+    "evaluate_controller", "group_by_algorithm", "interval_text", "load_policy",
+    "markdown_table", "optimal_controller", "play", "reference_controller", "reference_effort",
+    "registered_controllers", "shipped_policies", "summarize", "write_comparison",
 ]

@@ -10,12 +10,17 @@ import numpy as np
 import pytest
 
 from baselines.compare import (
+    CONTROLLER_FACTORIES,
     OPTIMAL,
+    Controller,
     Episode,
     compare,
+    group_by_algorithm,
+    interval_text,
     markdown_table,
     reference_controller,
     reference_effort,
+    registered_controllers,
     shipped_policies,
     summarize,
     write_comparison,
@@ -26,34 +31,38 @@ MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
 
 
-def random_controller(env_id: str, **env_kwargs: object) -> tuple:
-    """A seeded random policy factory and its env arguments."""
+def random_controller() -> Controller:
+    """A seeded random policy on the env it is given."""
 
-    def factory():  # type: ignore[no-untyped-def]
-        space = gym.make(env_id, **env_kwargs).action_space
+    def make_policy(env: gym.Env) -> object:
+        space = env.action_space
         space.seed(0)
         return lambda _obs: space.sample()
 
-    return factory, dict(env_kwargs)
+    return Controller("random", make_policy)
 
 
 @pytest.fixture(scope="module")
 def manipulator_comparison() -> dict:
-    """The optimum, its own controls as an extra "policy", and a random policy; 2 seeds."""
+    """The optimum, its own controls as an extra controller, and a random policy; 2 starts."""
     reference = load_reference("manipulator_time")
-    return compare(MANIPULATOR, "time", num_seeds=2, policies=[], extra_controllers={
-        "reference controls": reference_controller(reference),
-        "random": random_controller(MANIPULATOR),
-    })  # fmt: skip
+    return compare(MANIPULATOR, "time", num_seeds=2, policies=[], extra_controllers=[
+        reference_controller(reference, "reference controls"), random_controller()])
 
 
 def _row(comparison: dict, label: str) -> dict:
     return next(row for row in comparison["controllers"] if row["label"] == label)
 
 
+def _run(comparison: dict, label: str) -> dict:
+    """The only run of an untrained controller."""
+    (run,) = _row(comparison, label)["runs"]
+    return run
+
+
 def test_optimal_controls_score_ratio_one(manipulator_comparison: dict) -> None:
     for label in (OPTIMAL, "reference controls"):
-        nominal = _row(manipulator_comparison, label)["nominal"]
+        nominal = _run(manipulator_comparison, label)["nominal"]
         assert nominal.is_success
         assert nominal.elapsed_time / manipulator_comparison["optimal_time"] == pytest.approx(
             1.0, abs=1e-9)
@@ -65,27 +74,30 @@ def test_optimal_controls_score_ratio_one(manipulator_comparison: dict) -> None:
 
 
 def test_random_policy_is_reported_as_failure(manipulator_comparison: dict) -> None:
-    row = _row(manipulator_comparison, "random")
-    assert row["summary"]["success_rate"] == 0.0
-    assert row["summary"]["time_ratio"] is None and row["summary"]["effort_ratio"] is None
-    assert not row["nominal"].is_success
-    assert all(e.elapsed_time == pytest.approx(10.0) for e in row["episodes"])  # truncated
+    run = _run(manipulator_comparison, "random")
+    assert run["summary"]["success_rate"] == 0.0
+    assert run["summary"]["time_ratio"] is None and run["summary"]["effort_ratio"] is None
+    assert not run["nominal"].is_success
+    assert all(e.elapsed_time == pytest.approx(10.0) for e in run["episodes"])  # truncated
+    aggregate = _row(manipulator_comparison, "random")["aggregate"]
+    assert aggregate["time_ratio"] == {"n": 0, "missing": 1, "iqm": None, "ci": None,
+                                       "values": []}  # fmt: skip
     table = markdown_table([manipulator_comparison])
-    assert "| random | 0% of 2 | - | - | fails |" in table
+    assert "| random | controller, 2 starts | 0 % | - | - | fails |  |" in table
 
 
 def test_perturbed_starts_differ_from_nominal(manipulator_comparison: dict) -> None:
-    row = _row(manipulator_comparison, OPTIMAL)
-    starts = [e.q[0] for e in row["episodes"]]
+    run = _run(manipulator_comparison, OPTIMAL)
+    starts = [e.q[0] for e in run["episodes"]]
     assert not np.allclose(starts[0], starts[1])
-    assert 0.0 < np.max(np.abs(starts[0] - row["nominal"].q[0])) <= 0.01
+    assert 0.0 < np.max(np.abs(starts[0] - run["nominal"].q[0])) <= 0.01
 
 
 def test_effort_task_reference_ratio_one() -> None:
     reference = load_reference("diff_drive_effort")
     assert reference_effort(reference) == pytest.approx(reference.cost, rel=1e-12)
     comparison = compare(DIFF_DRIVE, "effort", num_seeds=1, policies=[])
-    nominal = _row(comparison, OPTIMAL)["nominal"]
+    nominal = _run(comparison, OPTIMAL)["nominal"]
     assert nominal.is_success
     assert nominal.effort / comparison["optimal_effort"] == pytest.approx(1.0, rel=1e-6)
     assert set(np.unique(nominal.schedule)) <= {2.0, 3.0, 5.0}
@@ -105,12 +117,39 @@ def test_summarize_counts_only_successes() -> None:
 
 
 def test_write_comparison(manipulator_comparison: dict, tmp_path: Path) -> None:
-    json_path, png_path = write_comparison(manipulator_comparison, tmp_path)
+    json_path, png_path, seeds_path = write_comparison(manipulator_comparison, tmp_path)
     record = json.loads(json_path.read_text())
     assert [row["label"] for row in record["controllers"]] == [OPTIMAL, "reference controls",
                                                                  "random"]  # fmt: skip
-    assert len(record["controllers"][0]["episodes"]) == 2
-    assert png_path.stat().st_size > 10_000
+    assert len(record["controllers"][0]["runs"][0]["episodes"]) == 2
+    optimal = record["controllers"][0]
+    assert optimal["aggregate"]["success_rate"]["iqm"] == optimal["runs"][0]["summary"][
+        "success_rate"]  # one run: its own score, no interval
+    assert optimal["aggregate"]["success_rate"]["ci"] is None
+    assert png_path.stat().st_size > 10_000 and seeds_path.stat().st_size > 10_000
+
+
+def test_controller_hook_names_the_optimal_reference() -> None:
+    assert CONTROLLER_FACTORIES[0] == "baselines.compare:optimal_controller"
+    assert [c.label for c in registered_controllers(DIFF_DRIVE, "effort")] == [OPTIMAL]
+    assert registered_controllers(MANIPULATOR, "effort") == []  # no reference: no row
+
+
+def test_interval_text_says_n_and_never_shows_one_run_as_an_interval() -> None:
+    one = {"n": 1, "missing": 0, "iqm": 0.95, "ci": None, "values": [0.95]}
+    assert interval_text(one, percent=True) == "95 % (n=1, no CI)"
+    five = {"n": 4, "missing": 1, "iqm": 1.234, "ci": [1.1, 1.5], "values": []}
+    assert interval_text(five) == "1.23 [1.10, 1.50] (n=4, 1 without)"
+    assert interval_text({"n": 0, "missing": 2, "iqm": None, "ci": None, "values": []}) == "-"
+
+
+def test_group_by_algorithm_sorts_seeds(tmp_path: Path) -> None:
+    for seed in (2, 0, 1):
+        (tmp_path / f"p{seed}.json").write_text(json.dumps({"algo": "PPO", "seed": seed}))
+    (tmp_path / "s.json").write_text(json.dumps({"algo": "SAC", "seed": 0}))
+    groups = group_by_algorithm(sorted(tmp_path.glob("*.json")))
+    assert groups == {"PPO": [tmp_path / f"p{s}.json" for s in (0, 1, 2)],
+                      "SAC": [tmp_path / "s.json"]}  # fmt: skip
 
 
 def test_unknown_task_is_rejected() -> None:
@@ -138,3 +177,33 @@ def test_compare_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert (tmp_path / "compare_BlockableManipulator-v0_time.png").exists()
     with pytest.raises(SystemExit, match="has no task"):
         main(["compare", MANIPULATOR, "--task", "effort", "--output", str(tmp_path)])
+
+
+@pytest.mark.slow
+def test_compare_aggregates_the_seeds_of_an_algorithm(tmp_path: Path) -> None:
+    """Two tiny PPO runs (seeds 1, 2) form one row: IQM, a CI, n=2, curves from their CSVs."""
+    import torch
+
+    from baselines.seed_plots import episode_log
+    from baselines.train import train
+
+    torch.set_num_threads(1)
+    overrides = {"n_steps": 64, "batch_size": 64, "n_epochs": 1,
+                 "policy_kwargs": {"net_arch": [8, 8]}}  # fmt: skip
+    for seed in (1, 2):  # 2 copies x 576 steps: each copy ends one 500-step episode
+        train(MANIPULATOR, "PPO", seed=seed, total_timesteps=1100, output=tmp_path, num_envs=2,
+              algo_overrides=overrides, eval_episodes=0, progress_bar=False)  # fmt: skip
+    comparison = compare(MANIPULATOR, "time", num_seeds=2, trained_dir=tmp_path,
+                         bootstrap_reps=200)  # fmt: skip
+    row = _row(comparison, "PPO")
+    assert row["trained"] and [run["seed"] for run in row["runs"]] == [1, 2]
+    success = row["aggregate"]["success_rate"]
+    assert success["n"] == 2 and success["ci"] is not None
+    assert success["ci"][0] <= success["iqm"] <= success["ci"][1]
+    table = markdown_table([comparison])
+    assert "| PPO | 2 seeds x 2 starts | " in table and "(n=2)" in table
+    assert "1.2e+03 steps, 2 envs, seeds 1-2 |" in table  # 1152 steps taken
+    steps, wins = episode_log(row["runs"][0]["config"], tmp_path)
+    assert len(steps) == len(wins) == 2
+    paths = write_comparison(comparison, tmp_path / "out", tmp_path)
+    assert all(path.stat().st_size > 10_000 for path in paths[1:])

@@ -1,0 +1,51 @@
+"""Statistics over seeds (rliable): IQM, bootstrap CIs, moving success curves."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from baselines.aggregate import iqm_interval, performance_profiles, success_curve, training_curves
+
+pytest.importorskip("rliable", reason="rliable is in the rl extra")
+
+
+def test_iqm_interval_trims_quartiles_and_brackets_the_estimate() -> None:
+    values = [0.0, 0.9, 0.95, 1.0, 1.0, 1.0, 1.0, 10.0]  # IQM: mean of the middle four
+    estimate = iqm_interval(values, reps=500)
+    assert estimate["iqm"] == pytest.approx(np.mean([0.95, 1.0, 1.0, 1.0]))
+    assert estimate["n"] == 8 and estimate["missing"] == 0
+    low, high = estimate["ci"]
+    assert low <= estimate["iqm"] <= high
+    before = np.random.get_state()[1].copy()
+    assert iqm_interval(values, reps=500) == estimate  # seeded resampling
+    assert np.array_equal(np.random.get_state()[1], before)  # the global generator restored
+
+
+def test_iqm_interval_drops_missing_runs_and_gives_one_run_no_interval() -> None:
+    assert iqm_interval([1.5, None, float("nan")]) == {"n": 1, "missing": 2, "iqm": 1.5,
+                                                        "ci": None, "values": [1.5]}  # fmt: skip
+    assert iqm_interval([])["iqm"] is None
+
+
+def test_success_curve_is_the_moving_mean_of_finished_episodes() -> None:
+    steps = np.array([10.0, 20.0, 30.0, 40.0])
+    success = np.array([0.0, 1.0, 1.0, 1.0])
+    curve = success_curve(steps, success, np.array([5.0, 10.0, 25.0, 40.0]), window=2)
+    assert np.isnan(curve[0])
+    assert curve[1:] == pytest.approx([0.0, 0.5, 1.0])
+
+
+def test_training_curves_band_needs_two_runs() -> None:
+    run = (np.arange(1.0, 201.0), (np.arange(200) > 100).astype(float))
+    curves = training_curves({"one": [run], "two": [run, run]}, num_points=5, reps=100)
+    assert curves["one"]["ci"] is None and curves["one"]["n"] == 1
+    assert curves["two"]["ci"].shape == (2, 5)
+    assert curves["two"]["iqm"] == pytest.approx(curves["one"]["iqm"])
+
+
+def test_performance_profile_counts_runs_above_tau() -> None:
+    profiles, intervals = performance_profiles({"a": [0.2, 0.6, 1.0]}, np.array([0.0, 0.5, 1.0]),
+                                               reps=100)  # fmt: skip
+    assert profiles["a"] == pytest.approx([1.0, 2 / 3, 0.0])
+    assert intervals["a"].shape == (2, 3)
