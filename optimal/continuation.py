@@ -115,18 +115,24 @@ def solve_continuation(
     schedule: Schedule | None = None,
     progress: Callable[[str], None] | None = None,
     residual_tolerance: float = 1e-6,
+    initial: np.ndarray | None = None,
 ) -> ContinuationResult:
-    """Run the continuation from the naive guess.
+    """Run the continuation from the naive guess (or from ``initial``).
 
     Args:
         transcription: the NLP. schedule: stages (default ``Schedule()``).
         progress: called with one line per stage (e.g. ``print``); None is silent.
         residual_tolerance: the last stage's natural residual must be below this for success.
+        initial: (nx,) a point of the NLP's variables to start from (e.g. a fixed-pattern
+            solution, ``optimal.mode_search``); None starts from the naive guess.
     """
     schedule = schedule or Schedule()
     opti = transcription.opti
-    _set_solver(opti, schedule, BOUND_RELAXATION)
-    transcription.set_naive_guess()
+    set_solver(opti, schedule, BOUND_RELAXATION)
+    if initial is None:
+        transcription.set_naive_guess()
+    else:
+        opti.set_initial(opti.x, initial)
     history: list[StageRecord] = []
     values: Callable[[Any], Any] = opti.debug.value
     status = ""
@@ -143,7 +149,7 @@ def solve_continuation(
                 opti.set_initial(opti.x, point)
             else:
                 _fix_active_sets(transcription, values)
-            _set_solver(opti, schedule, POLISH_BOUND_RELAXATION)
+            set_solver(opti, schedule, POLISH_BOUND_RELAXATION)
         opti.set_value(transcription.rho, penalty)
         opti.set_value(transcription.relaxation, relaxation)
         start = time.perf_counter()
@@ -179,7 +185,7 @@ def solve_continuation(
                               transcription=transcription)
 
 
-def _set_solver(opti: Any, schedule: Schedule, bound_relaxation: float) -> None:
+def set_solver(opti: Any, schedule: Schedule, bound_relaxation: float) -> None:
     """IPOPT with CasADi's exact Hessian, quiet, with the schedule's limits."""
     opti.solver("ipopt", {"expand": True, "print_time": False},
                 {"print_level": 0, "max_iter": schedule.max_iterations,
@@ -218,4 +224,7 @@ def _fix_active_sets(transcription: Transcription, values: Callable[[Any], Any])
     opti.subject_to(stacked[sorted(int(i) for i in pivots[:rank])] == 0)
 
 
-__all__ = ["ContinuationResult", "Schedule", "StageRecord", "solve_continuation"]
+__all__ = [
+    "BOUND_RELAXATION", "POLISH_BOUND_RELAXATION", "POLISH_RELAXATION", "ContinuationResult",
+    "Schedule", "StageRecord", "set_solver", "solve_continuation",
+]

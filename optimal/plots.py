@@ -13,7 +13,7 @@ import numpy as np
 from optimal.references import Reference
 
 SLIDING_SPEED = 1e-6
-"""[m/s] a wheel counts as sliding above this slip speed (as ``optimal.solve.SLIP_TOLERANCE``
+"""[m/s] a wheel counts as sliding above this slip speed (as ``optimal.mode_search.SLIP_TOLERANCE``
 with the robot's 1 m/s velocity unit)."""
 
 
@@ -29,6 +29,62 @@ def plot_reference(reference: Reference, directory: Path | str) -> list[Path]:
     if "mode" in reference.arrays:
         return _robot(reference, folder)
     return []
+
+
+def plot_search(reference: Reference, directory: Path | str) -> Path:
+    """The global search and refinement of a searched reference (``metadata["search"]``).
+
+    Left: the best cost after each start (does the search saturate?) with every start's
+    continuation optimum and its optimum after the mode-neighbourhood search. Right: the
+    cost against N over the refinement levels. Saved as ``NAME_search.png``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    meta = reference.metadata
+    search, refinement = meta["search"], meta["refinement"]
+    unit = "s" if meta["cost_kind"] == "time" else "N² m² s"
+    label = "t_f" if meta["cost_kind"] == "time" else "effort"
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4), width_ratios=(2, 1))
+    starts = np.arange(1, search["starts"] + 1)
+    per_start = search["per_start"]
+    nan = float("nan")
+    left.scatter(starts, [nan if r["continuation_cost"] is None else r["continuation_cost"]
+                          for r in per_start], marker="x", color="0.6",
+                 label="continuation optimum")
+    left.scatter(starts, [nan if r["local_cost"] is None else r["local_cost"]
+                          for r in per_start], marker="o", facecolors="none",
+                 edgecolors="C0", label="after the mode search")
+    left.step(starts, search["running_best"], where="post", color="C3", label="best so far")
+    finite = [c for r in per_start for c in (r["continuation_cost"], r["local_cost"])
+              if c is not None and np.isfinite(c)]
+    if finite:
+        low = min(finite)
+        left.set_ylim(low * 0.99, min(max(finite), 2.0 * low) * 1.01)
+    left.set_xlabel("start (completion order)")
+    left.set_ylabel(f"{label} [{unit}]")
+    left.set_title(f"{reference.name}: {search['starts']} starts, {search['solves']} "
+                   f"fixed-pattern solves, {search['wall_time'] / 60:.0f} min")
+    left.legend(fontsize=8)
+    levels = refinement["levels"]
+    right.plot([lv["num_intervals"] for lv in levels], [lv["cost"] for lv in levels], "o-")
+    shipped = levels[meta["shipped_level"]]
+    right.plot([shipped["num_intervals"]], [shipped["cost"]], "r*", markersize=12,
+               label="shipped")
+    right.set_xscale("log", base=2)
+    right.set_xlabel("N (intervals)")
+    right.set_ylabel(f"{label} [{unit}]")
+    right.set_title("mesh refinement")
+    right.legend(fontsize=8)
+    fig.tight_layout()
+    folder = Path(directory)
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{reference.name}_search.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
 
 
 def _manipulator(reference: Reference, folder: Path) -> list[Path]:

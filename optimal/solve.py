@@ -11,28 +11,21 @@ import os
 import platform
 import subprocess
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from optimal.continuation import Schedule, solve_continuation
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
 from optimal.replay import replay
-from optimal.transcription import Transcription, numeric
+from optimal.solution import read_solution, values_at
+from optimal.transcription import OptimalControlProblem, Transcription
 
-BRAKE_VELOCITY_TOLERANCE = 1e-6
-"""A brake counts as engaged over an interval when |W_B u_{k+1}| is below this fraction of the
-problem's velocity scale (the polished solution has exact zeros there, ~1e-12). Where the
-relative velocity is zero and the brake impulse too, engaged and released give the same step."""
-
-SLIP_TOLERANCE = 1e-6
-"""A contact slides over an interval when its slip speed exceeds this fraction of the
-problem's velocity scale."""
+if TYPE_CHECKING:
+    from optimal.global_search import StartResult
 
 GUESS_TIME_FACTORS = {"manipulator_time": (0.66, 0.88, 1.0, 1.1, 1.32)}
 """Multi-start: the naive guess is repeated with t_f scaled by these factors and the best
@@ -44,6 +37,10 @@ SCHEDULES = {"diff_drive_time": Schedule(mu_strategy="monotone"),
 """Per-problem continuation schedules (others: ``Schedule()``). The robot's first stage, from
 the naive guess far from complementarity, takes 5-20x fewer IPOPT iterations with the monotone
 barrier update."""
+
+SHIPPED_LEVEL_CHANGE = 0.005
+"""``search_reference`` ships the coarsest refinement level whose cost changes by less than
+this fraction (0.5 %) to the next finer one."""
 
 ENV_VERSION = 0
 """The ``-vN`` of the environment ids the references are computed for."""
@@ -72,7 +69,6 @@ def solve_problem(
     """
     base = make_problem(name, num_intervals)
     schedule = schedule or SCHEDULES.get(name)
-    model, parameters = model_of(base)
     start = time.perf_counter()
     factors = GUESS_TIME_FACTORS.get(name, (1.0,))
     workers = min(len(factors), os.cpu_count() or 1) if workers is None else int(workers)
@@ -91,9 +87,81 @@ def solve_problem(
     arrays, final_time = best["arrays"], best["final_time"]
     starts = [{"guess_final_time": s["guess_final_time"], "cost": s["cost"],
                "converged": s["converged"], "solve_time": s["solve_time"]} for s in solved]
-    big_n = problem.num_intervals
-    metadata: dict[str, Any] = {
-        "name": name,
+    metadata = _metadata(problem, best["cost"], final_time, best["converged"])
+    metadata.update(history=best["history"], guess_final_time=problem.final_time, starts=starts,
+                    solve_time=sum(entry["solve_time"] for entry in starts),
+                    total_time=total_time, workers=workers)
+    return _verified(Reference(name, arrays, metadata), progress)
+
+
+def search_reference(
+    name: str,
+    num_starts: int,
+    refine_factors: Sequence[int] = (2, 4),
+    num_intervals: int | None = None,
+    seed: int = 0,
+    workers: int | None = None,
+    progress: Callable[[str], None] | None = None,
+    show_bar: bool = True,
+) -> tuple[Reference, dict[str, Any]]:
+    """The best optimum a global search finds, refined, verified by replay.
+
+    Runs ``optimal.global_search.global_search`` (``num_starts`` starts, each continued and
+    mode-neighbourhood searched), refines the best to N x ``refine_factors``
+    (``optimal.refinement.refine``), and returns the reference at the coarsest level whose
+    cost changes by less than ``SHIPPED_LEVEL_CHANGE`` to the next (the finest level if none
+    does), with the search and the refinement in its metadata.
+
+    Args:
+        name: the problem. num_starts: of the search. refine_factors: N multiples to refine
+            to (empty: no refinement). num_intervals: N_0. seed: of the random starts.
+        workers: processes of the search (default one per core). progress: one line per
+            start and level. show_bar: a progress bar over the starts.
+
+    Returns:
+        (reference, report): the report holds the search's and the refinement's summaries
+        (``GlobalSearch.summary``, ``Refinement.summary``) and the level shipped.
+    """
+    from optimal.global_search import global_search
+    from optimal.refinement import refine
+
+    clock = time.perf_counter()
+
+    def started(result: StartResult) -> None:
+        if progress is not None:
+            local = "-" if result.best is None else f"{result.best.cost:.6g}"
+            progress(f"  {result.start.label}: continuation {result.continuation_cost:.6g}, "
+                     f"after the mode search {local} ({result.wall_time:.0f} s)")
+
+    search = global_search(name, num_starts, num_intervals, seed=seed, workers=workers,
+                           progress=started, show_bar=show_bar)
+    best = search.best.best
+    assert best is not None
+    schedule = SCHEDULES.get(name) or Schedule()
+    refinement = refine(search.problem, best, refine_factors, mu_strategy=schedule.mu_strategy,
+                        make=lambda n: make_problem(name, n), progress=progress)
+    changes = refinement.relative_changes()
+    shipped = next((i for i, change in enumerate(changes)
+                    if abs(change) < SHIPPED_LEVEL_CHANGE), len(changes))
+    level = refinement.levels[shipped]
+    problem, solve = level.problem, level.solve
+    arrays, final_time = read_solution(*values_at(problem, solve.modes, solve.point))
+    report = {"search": search.summary(), "refinement": refinement.summary(),
+              "shipped_level": shipped}
+    metadata = _metadata(problem, solve.cost, final_time, solve.success and solve.residual <= 1e-8)
+    metadata.update(method=metadata["method"] + "; global search: multi-start + mode-"
+                    "neighbourhood search (optimal.global_search), mesh refinement",
+                    residual=solve.residual, guess_final_time=search.best.start.final_time,
+                    total_time=time.perf_counter() - clock, **report)
+    return _verified(Reference(name, arrays, metadata), progress), report
+
+
+def _metadata(problem: OptimalControlProblem, cost: float, final_time: float,
+              converged: bool) -> dict[str, Any]:
+    """The metadata every reference carries (the solver's own records are added to it)."""
+    model, parameters = model_of(problem)
+    return {
+        "name": problem.name,
         "description": problem.description,
         "env_id": problem.env_id,
         "env_version": ENV_VERSION,
@@ -103,23 +171,20 @@ def solve_problem(
         "method": "midpoint transcription, penalty/continuation (SUMT) + active-set polish, "
                   "CasADi/IPOPT",
         "cost_kind": problem.cost,
-        "cost": best["cost"],
+        "cost": cost,
         "final_time": final_time,
-        "num_intervals": big_n,
-        "time_step": final_time / big_n,
+        "num_intervals": problem.num_intervals,
+        "time_step": final_time / problem.num_intervals,
         "torque_bound": problem.torque_bound,
-        "converged": best["converged"],
-        "history": best["history"],
-        "guess_final_time": problem.final_time,
-        "starts": starts,
-        "solve_time": sum(entry["solve_time"] for entry in starts),
-        "total_time": total_time,
-        "workers": workers,
+        "converged": converged,
         "commit": _commit(),
         "casadi": _casadi_version(),
         "python": platform.python_version(),
     }
-    reference = Reference(name, arrays, metadata)
+
+
+def _verified(reference: Reference, progress: Callable[[str], None] | None) -> Reference:
+    """The reference with its replays at h and h/10 in ``metadata["replay"]``."""
     replays = []
     for substeps in (1, 10):
         report = replay(reference, substeps)[0]
@@ -128,7 +193,7 @@ def solve_problem(
             progress(f"  replay at h/{substeps}: final-state error {report.state_error:.2e}, "
                      f"goal errors {_short(report.goal_errors)}, "
                      f"{'reaches' if report.reaches_goal else 'MISSES'} the goal")
-    metadata["replay"] = replays
+    reference.metadata["replay"] = replays
     return reference
 
 
@@ -142,7 +207,6 @@ def _solve_start(name: str, num_intervals: int | None, schedule: Schedule | None
     """
     problem = make_problem(name, num_intervals)
     problem = dataclasses.replace(problem, final_time=factor * problem.final_time)
-    model, _ = model_of(problem)
     if progress is None and verbose:
         def progress(line: str) -> None:
             print(f"[guess t_f = {problem.final_time:.2f} s] {line}", flush=True)
@@ -152,33 +216,10 @@ def _solve_start(name: str, num_intervals: int | None, schedule: Schedule | None
                  f"naive guess t_f = {problem.final_time:.3f} s")
     result = solve_continuation(transcription, schedule, progress)
     transcription = result.transcription or transcription
-    values = result.values
-    final_time = float(values(transcription.final_time)) if problem.cost == "time" else float(
-        problem.final_time)
-    big_n = problem.num_intervals
-    arrays: dict[str, np.ndarray] = {
-        "time": np.linspace(0.0, final_time, big_n + 1),
-        "q": numeric(values(transcription.q)).reshape(model.NUM_DOFS, big_n + 1).T.copy(),
-        "u": numeric(values(transcription.u)).reshape(model.NUM_DOFS, big_n + 1).T.copy(),
-        "tau": numeric(values(transcription.tau)).reshape(model.NUM_INPUTS, big_n).T.copy(),
-    }
-    outputs = {key: numeric(values(expr)).reshape(-1, big_n).T.copy()
-               for key, expr in transcription.outputs.items()}
-    if model.NUM_BRAKES:
-        engaged = np.abs(outputs["brake_velocity"]) <= (
-            BRAKE_VELOCITY_TOLERANCE * problem.velocity_scale)
-        arrays["brake_bound"] = np.where(engaged, np.inf, 0.0)
-        arrays["brake_impulse"] = outputs["brake_impulse"]
-    if model.NUM_CONTACTS:
-        arrays["normal_impulse"] = outputs["normal_impulse"]
-    if "slip_speed" in outputs:
-        arrays["tangent_impulse"] = outputs["tangent_impulse"]
-        arrays["slip_speed"] = outputs["slip_speed"]
-        sliding = (outputs["slip_speed"] > SLIP_TOLERANCE * problem.velocity_scale).astype(int)
-        arrays["mode"] = np.array([model.slip_mode(row) for row in sliding], dtype=np.int64)
+    arrays, final_time = read_solution(transcription, result.values)
     return {
         "factor": factor, "guess_final_time": problem.final_time,
-        "cost": float(values(transcription.cost)), "converged": result.success,
+        "cost": float(result.values(transcription.cost)), "converged": result.success,
         "solve_time": sum(r.solve_time for r in result.history),
         "history": [dataclasses.asdict(record) for record in result.history],
         "final_time": final_time, "arrays": arrays,
@@ -208,4 +249,4 @@ def _casadi_version() -> str:
     return str(getattr(casadi, "__version__", "unknown"))
 
 
-__all__ = ["BRAKE_VELOCITY_TOLERANCE", "ENV_VERSION", "SLIP_TOLERANCE", "solve_problem"]
+__all__ = ["ENV_VERSION", "SHIPPED_LEVEL_CHANGE", "search_reference", "solve_problem"]

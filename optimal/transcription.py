@@ -50,6 +50,7 @@ import numpy as np
 from mdi_envs._types import FloatArray
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.mechanics.symbolic import symbolic_equations
+from optimal.modes import ModePattern
 
 IMPLICIT_THETA = 0.5
 """The stepper's theta for velocity-dependent forces (``mdi_envs.stepping._kernel``)."""
@@ -132,9 +133,10 @@ class Transcription:
     """The NLP of one problem, built once; ``continuation`` solves it stage by stage.
 
     Attributes:
-        problem: the problem transcribed. active_set: None, or for load-transfer contacts a
-            (c, N) boolean array (True: the contact slides over the interval) that fixes the
-            modes: the polish NLP (see ``polished``). opti: the ``casadi.Opti`` instance.
+        problem: the problem transcribed. modes: None (the modes are free: complementarity
+            pairs), or a ``ModePattern`` whose brake and contact modes the NLP states exactly
+            (the polish NLP of ``polished``, the fixed-pattern solves of
+            ``optimal.mode_search``). opti: the ``casadi.Opti`` instance.
         q: (n, N+1) coordinates. u: (n, N+1) velocities. tau: (m, N) inputs.
         final_time: t_f (a variable or a float). step: h = t_f / N.
         rho: penalty weight (parameter). relaxation: bound r on each scaled product (parameter).
@@ -143,7 +145,7 @@ class Transcription:
     """
 
     problem: OptimalControlProblem
-    active_set: Any = None
+    modes: ModePattern | None = None
     opti: Any = field(init=False)
     q: Any = field(init=False)
     u: Any = field(init=False)
@@ -190,13 +192,18 @@ class Transcription:
         self.step = h
         self.rho, self.relaxation = opti.parameter(), opti.parameter()
 
-        brake = _BrakeLaw(opti, self.variable, k, big_n, s_imp, s_vel) if k else None
+        modes = self.modes or ModePattern()
+        if modes.num_intervals not in (0, big_n):
+            raise ValueError(f"the mode pattern has {modes.num_intervals} intervals, the "
+                             f"problem {big_n}")
+        brake = _BrakeLaw(opti, self.variable, k, big_n, s_imp, s_vel,
+                          modes.engaged) if k else None
         gap = contact = None
         if c and model.HAS_LOAD_TRANSFER:
             if d != 3:
                 raise NotImplementedError("load-transfer contacts are transcribed in 3-D only")
             contact = _LoadTransferLaw(opti, self.variable, model, values, big_n, s_imp, s_vel,
-                                       self.active_set)
+                                       modes.sliding)
         elif c:
             if any(mu > 0.0 for mu in model.friction_coefficients(values)) or d != 2:
                 raise NotImplementedError("gap contacts are transcribed without friction only")
@@ -277,7 +284,7 @@ class Transcription:
         cone = np.asarray(values(self._cone_slack), dtype=float)
         pr = self.problem
         sliding = contact_slip / pr.velocity_scale > cone / pr.impulse_scale**2
-        return Transcription(pr, active_set=sliding)
+        return Transcription(pr, modes=ModePattern(sliding=np.atleast_2d(sliding)))
 
     def set_naive_guess(self) -> None:
         """The documented naive initial guess.
@@ -292,12 +299,27 @@ class Transcription:
         start = np.asarray(pr.initial_q, dtype=float)
         end = np.asarray(pr.guess_final_q, dtype=float)
         weights = np.linspace(0.0, 1.0, big_n + 1)
-        self._set_initial(self.q, start[:, None] + (end - start)[:, None] * weights)
         rate = (end - start) / pr.final_time
-        self._set_initial(self.u, np.repeat(rate[:, None], big_n + 1, axis=1))
-        self._set_initial(self.tau, np.zeros(self.tau.shape))
-        if pr.cost == "time":
-            self._set_initial(self.final_time, pr.final_time)
+        self.set_guess(start[None, :] + (end - start)[None, :] * weights[:, None],
+                       np.repeat(rate[None, :], big_n + 1, axis=0),
+                       np.zeros((big_n, pr.model.NUM_INPUTS)), pr.final_time)
+
+    def set_guess(self, q: FloatArray, u: FloatArray, tau: FloatArray,
+                  final_time: float) -> None:
+        """An initial guess from a trajectory on this grid, impulses zero.
+
+        Args:
+            q: (N+1, n) coordinates. u: (N+1, n) velocities. tau: (N, m) inputs.
+            final_time: t_f [s] (used when it is a variable).
+
+        Every slack takes the value its defining equation gives at this guess with zero
+        impulses (brakes released).
+        """
+        self._set_initial(self.q, np.asarray(q, dtype=float).T)
+        self._set_initial(self.u, np.asarray(u, dtype=float).T)
+        self._set_initial(self.tau, np.asarray(tau, dtype=float).T)
+        if self.problem.cost == "time":
+            self._set_initial(self.final_time, final_time)
         for variable, guess in self._slack_guesses:
             self._set_initial(variable, self.opti.value(guess(), self.opti.initial()))
 
@@ -348,12 +370,23 @@ class _BrakeLaw:
     num_intervals: int
     impulse_unit: float
     velocity_unit: float
+    engaged: Any = None
 
     def __post_init__(self) -> None:
+        import casadi
+
         shape = (self.num_brakes, self.num_intervals)
         self.impulse_parts = tuple(self.new(shape, self.impulse_unit, True) for _ in range(2))
         self.velocity_parts = tuple(self.new(shape, self.velocity_unit, True) for _ in range(2))
         self._rows: list[Any] = []
+        if self.engaged is not None:  # fixed modes: engaged -> xi_B = 0, released -> P_B = 0
+            engaged = np.asarray(self.engaged, dtype=bool).ravel(order="F")
+            for parts, unit, where in ((self.velocity_parts, self.velocity_unit, engaged),
+                                       (self.impulse_parts, self.impulse_unit, ~engaged)):
+                indices = np.flatnonzero(where).tolist()
+                if indices:
+                    for part in parts:
+                        self.opti.subject_to(casadi.vec(part)[indices] / unit == 0)
 
     def interval(self, i: int, rows: Any, u_next: Any) -> Any:
         """Generalized brake impulse W_B^T P_B of interval i; ties v+ - v- to W_B u_{k+1}."""
@@ -457,7 +490,7 @@ class _LoadTransferLaw:
     num_intervals: int
     impulse_unit: float
     velocity_unit: float
-    active_set: Any = None
+    sliding: Any = None
 
     def __post_init__(self) -> None:
         c = self.model.NUM_CONTACTS
@@ -495,7 +528,7 @@ class _LoadTransferLaw:
             cones.append((self._mu[j] * p_n[j]) ** 2 - casadi.sumsqr(pj))
             if at_rest:
                 self.opti.subject_to(self.slip_speed[j, i] / speed_unit == 0)
-            elif self.active_set is not None and not self.active_set[j, i]:  # sticks
+            elif self.sliding is not None and not self.sliding[j, i]:  # sticks
                 self.opti.subject_to(self.slip_speed[j, i] / speed_unit == 0)
                 for row in (2 * j, 2 * j + 1):
                     if not any(self._same_row[row, other] for other in stated):
@@ -506,7 +539,7 @@ class _LoadTransferLaw:
                     (self._mu[j] * p_n[j] * sj + self.slip_speed[j, i] * pj)
                     / (unit * speed_unit) == 0
                 )
-                if self.active_set is not None:  # slides: on the cone
+                if self.sliding is not None:  # slides: on the cone
                     self.opti.subject_to(self.cone_slack[j, i] / unit**2 == 0)
         cone = casadi.vertcat(*cones)
         self.opti.subject_to((self.cone_slack[:, i] - cone) / unit**2 == 0)

@@ -83,4 +83,4 @@ def test_robot_polish_nlp_has_the_same_variables() -> None:
     opti = transcription.opti
     polished = transcription.polished(lambda expression: opti.value(expression, opti.initial()))
     assert polished.opti.nx == transcription.opti.nx
-    assert polished.active_set.shape == (3, 6)
+    assert polished.modes is not None and polished.modes.sliding.shape == (3, 6)
