@@ -1,7 +1,8 @@
-"""``mdi-envs train ENV_ID ALGO``: train one SB3 baseline with the table's settings.
+"""``mdi-envs train``, ``compare`` and ``sweep``: the subcommands of the baselines.
 
 Wiring (in ``mdi_envs/cli.py``): ``from baselines.cli import add_train_parser`` and call
-``add_train_parser(commands)`` on the subparsers; the parser's handler is ``run_train``.
+``add_train_parser(commands)`` on the subparsers (likewise ``add_compare_parser``,
+``add_sweep_parser``); each parser's handler is its ``run_*`` function.
 Example: ``mdi-envs train mdi_envs/DiffDriveRobot-v0 PPO --task effort --output
 results/baselines`` (5 x 10^6 steps; the budget and settings are in
 ``baselines/hyperparams/*.yml``, rl-zoo3's format) shows SB3's progress bar on a terminal and
@@ -140,4 +141,71 @@ def run_compare(args: argparse.Namespace) -> int:
     return 0
 
 
-__all__ = ["add_compare_parser", "add_train_parser", "run_compare", "run_train"]
+def add_sweep_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``sweep`` subcommand to an argparse subparsers object; returns its parser."""
+    from baselines.hyperparameters import ALGORITHMS, DEFAULT_TASKS, canonical_algorithm
+
+    parser = subparsers.add_parser(
+        "sweep",
+        help="train the seed x algorithm x task grid through Ray Tune (resumable)",
+        description="Run mdi-envs train for every (env, task, algorithm) of the settings in "
+        "baselines/hyperparams and every --seeds, one Ray Tune trial each, locally on this "
+        "machine's cores or on an existing Ray cluster (--address). A run whose STEM.json is "
+        "already in --output is never rerun: the same command resumes an interrupted sweep. "
+        "The results are the files of mdi-envs train; mdi-envs compare all --trained OUTPUT "
+        "aggregates them over seeds. Needs the ray extra (pip install 'mdi-envs[ray]').",
+    )
+    parser.add_argument("--algos", nargs="+", type=canonical_algorithm, choices=ALGORITHMS,
+                        default=["PPO", "HybridPPO"], help="algorithms (default: PPO HybridPPO)")
+    parser.add_argument("--env-ids", nargs="+", choices=sorted(DEFAULT_TASKS), default=None,
+                        help="environments (default: both)")
+    parser.add_argument("--tasks", nargs="+", choices=("time", "effort"), default=None,
+                        help="tasks (default: every task the settings have)")
+    parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3, 4],
+                        help="training seeds (default: 0 1 2 3 4)")
+    parser.add_argument("--output", type=Path, default=Path("results/sweep"),
+                        help="the results folder (on a cluster: a path every node shares)")
+    parser.add_argument("--address", default=None,
+                        help="an existing Ray cluster, e.g. auto or ray://HOST:10001 "
+                        "(default: a local Ray instance)")
+    parser.add_argument("--num-cpus", type=int, default=None,
+                        help="cores of the local Ray instance (default: all)")
+    parser.add_argument("--cpus-per-trial", type=float, default=1.0,
+                        help="cores reserved per trial (default 1: torch runs on one thread)")
+    parser.add_argument("--timesteps", type=int, default=None,
+                        help="environment steps per run (default: the settings')")
+    parser.add_argument("--num-envs", type=int, default=None,
+                        help="batched copies per run (default: the settings')")
+    parser.add_argument("--eval-episodes", type=int, default=10,
+                        help="deterministic evaluation episodes after each run")
+    parser.add_argument("--dry-run", action="store_true",
+                        help="list the runs to do and the finished ones, run nothing")
+    parser.set_defaults(handler=run_sweep)
+    return parser
+
+
+def run_sweep(args: argparse.Namespace) -> int:
+    """Handler of ``sweep``: runs the grid, prints each run's outcome; returns 1 on a failure."""
+    from baselines.sweep import grid, is_finished, sweep
+
+    trials = grid(args.algos, args.seeds, args.env_ids, args.tasks)
+    if not trials:
+        raise SystemExit("sweep: no settings match these --algos, --env-ids and --tasks")
+    if args.dry_run:
+        for trial in trials:
+            state = "finished" if is_finished(trial, args.output) else "to run"
+            print(f"{trial.stem}: {state}")
+        return 0
+    outcome = sweep(trials, args.output, address=args.address, num_cpus=args.num_cpus,
+                    cpus_per_trial=args.cpus_per_trial, total_timesteps=args.timesteps,
+                    num_envs=args.num_envs, eval_episodes=args.eval_episodes,
+                    log=print)  # fmt: skip
+    print(f"sweep: {len(outcome['finished'])} finished now, {len(outcome['skipped'])} already "
+          f"done, {len(outcome['failed'])} failed; results in {args.output}")  # fmt: skip
+    return 1 if outcome["failed"] else 0
+
+
+__all__ = [
+    "add_compare_parser", "add_sweep_parser", "add_train_parser", "run_compare", "run_sweep",
+    "run_train",
+]

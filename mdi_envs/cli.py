@@ -3,7 +3,8 @@
 Subcommands: ``demo`` (solvers and the manipulator), ``compile`` (every kernel into the disk
 cache), ``solve`` (one Siconos file),
 ``simulate`` (one episode of an environment, optionally saved as GIF/MP4), ``optimize``
-(an optimal-control reference), ``train`` (an SB3 baseline), ``compare`` (the shipped baselines
+(an optimal-control reference), ``train`` (an SB3 baseline), ``sweep`` (the seed x algorithm x
+task grid of ``train`` through Ray Tune), ``compare`` (the trained baselines, over seeds,
 against the optimal references) and ``bench`` (the benchmark suite).
 Each subcommand imports what it needs inside its handler.
 """
@@ -106,12 +107,13 @@ def _build_parser() -> argparse.ArgumentParser:
                           help="worker processes (default: one per core)")
     compile_.set_defaults(handler=_run_compile)
 
-    from baselines.cli import add_compare_parser, add_train_parser
+    from baselines.cli import add_compare_parser, add_sweep_parser, add_train_parser
     from benchmarks.cli import add_bench_parser
     from optimal.cli import add_optimize_parser
 
     add_optimize_parser(commands)
     add_train_parser(commands)
+    add_sweep_parser(commands)
     add_compare_parser(commands)
     add_bench_parser(commands)
     return parser
