@@ -92,20 +92,30 @@ def performance_profiles(scores: Mapping[str, Sequence[float]], taus: np.ndarray
                          ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:  # fmt: skip
     """The score distributions of rliable: the fraction of runs with score > tau, with CIs.
 
+    Labels with one run get the profile alone (no bootstrap: it would only repeat the run).
+
     Args:
         scores: label -> one score per run. taus: (T,) thresholds.
         reps: bootstrap replications. seed: the resampling's seed.
 
     Returns:
-        (profiles: label -> (T,), intervals: label -> (2, T) lower and upper bounds).
+        (profiles: label -> (T,), intervals: label -> (2, T) lower and upper bounds, for the
+        labels with two runs or more).
     """
     from rliable import library
 
     matrices = {label: np.asarray(values, dtype=float)[:, None]
                 for label, values in scores.items() if len(values)}  # fmt: skip
-    with _seeded(seed):
-        return library.create_performance_profile(matrices, taus, reps=reps,
-                                                  confidence_interval_size=CONFIDENCE)
+    several = {label: m for label, m in matrices.items() if len(m) >= 2}
+    profiles: dict[str, np.ndarray] = {}
+    intervals: dict[str, np.ndarray] = {}
+    if several:
+        with _seeded(seed):
+            profiles, intervals = library.create_performance_profile(
+                several, taus, reps=reps, confidence_interval_size=CONFIDENCE)
+    singles = {label: np.mean(m[:, :, None] > taus, axis=(0, 1)) for label, m in matrices.items()
+               if label not in several}  # fmt: skip
+    return {label: {**profiles, **singles}[label] for label in matrices}, dict(intervals)
 
 
 def success_curve(steps: np.ndarray, success: np.ndarray, grid: np.ndarray,

@@ -373,7 +373,7 @@ def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
         for row in comparison["controllers"]:
             aggregate = row["aggregate"]
             if row["trained"]:
-                runs = f"{len(row['runs'])} seeds x {starts} starts"
+                runs = f"{len(row['runs'])} seed{'s' * (len(row['runs']) != 1)} x {starts} starts"
                 cells = [interval_text(aggregate["success_rate"], percent=True),
                          interval_text(aggregate["time_ratio"]),
                          interval_text(aggregate["effort_ratio"])]  # fmt: skip

@@ -45,7 +45,10 @@ def test_training_curves_band_needs_two_runs() -> None:
 
 
 def test_performance_profile_counts_runs_above_tau() -> None:
-    profiles, intervals = performance_profiles({"a": [0.2, 0.6, 1.0]}, np.array([0.0, 0.5, 1.0]),
+    taus = np.array([0.0, 0.5, 1.0])
+    profiles, intervals = performance_profiles({"a": [0.2, 0.6, 1.0], "one": [0.7]}, taus,
                                                reps=100)  # fmt: skip
     assert profiles["a"] == pytest.approx([1.0, 2 / 3, 0.0])
     assert intervals["a"].shape == (2, 3)
+    assert list(profiles) == ["a", "one"] and "one" not in intervals  # one run: no band
+    assert profiles["one"] == pytest.approx([1.0, 1.0, 0.0])
