@@ -76,9 +76,24 @@ def test_hybrid_ppo_through_the_zoo_launcher(tmp_path: Path) -> None:
     common = ["--algo", "hybridppo", "--env", MANIPULATOR, "--gym-packages", "mdi_envs",
               "-f", str(tmp_path)]  # fmt: skip
     main(["train", *common, "-conf", str(hyperparameter_file("HybridPPO")), "-n", "256",
-          "--seed", "0", "-params", "n_envs:2", "n_steps:64", "batch_size:64", "n_epochs:1"])
+          "--seed", "0", "--eval-freq", "128", "--eval-episodes", "1",  # evaluates once
+          "-params", "n_envs:2", "n_steps:64", "batch_size:64", "n_epochs:1"])
     assert (tmp_path / "hybridppo" / "mdi_envs-BlockableManipulator-v0_1"
             / "mdi_envs-BlockableManipulator-v0.zip").exists()  # fmt: skip
     main(["enjoy", *common, "-n", "50", "--no-render"])
     with pytest.raises(SystemExit, match="usage"):
         main(["play"])
+
+
+def test_the_launcher_gives_rl_zoo3_the_entry_env_kwargs_for_evaluation() -> None:
+    from baselines.zoo import eval_env_arguments
+
+    conf = str(hyperparameter_file("PPO", "effort"))
+    args = ["--algo", "ppo", "--env", "mdi_envs/DiffDriveRobot-v0", "-conf", conf]
+    extra = eval_env_arguments(args)
+    assert extra == ["--eval-env-kwargs", "task:'effort'", "goal_weight:1000.0",
+                     "shaping_discount:1.0"]  # fmt: skip
+    assert {k: eval(v) for k, v in (a.split(":", 1) for a in extra[1:])} == get_hyperparameters(
+        "mdi_envs/DiffDriveRobot-v0", "PPO", "effort")["env_kwargs"]  # rl-zoo3 evals each value
+    assert eval_env_arguments([*args, "--eval-env-kwargs", "task:'time'"]) == []
+    assert eval_env_arguments(["--env", "mdi_envs/DiffDriveRobot-v0"]) == []
