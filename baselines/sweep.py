@@ -143,16 +143,17 @@ def sweep(
                                       failure_config=tune.FailureConfig(max_failures=0),
                                       verbose=0),
         )  # fmt: skip
-        for result in tuner.fit():
-            stem = Trial(**result.config["trial"]).stem
-            if result.error is not None or not is_finished(Trial(**result.config["trial"]),
-                                                           output):  # fmt: skip
-                outcome["failed"].append(stem)
-                say(f"{stem}: failed ({type(result.error).__name__}: {result.error})")
+        results = tuner.fit()
+        for index in range(len(results)):  # a ResultGrid indexes, typed without __iter__
+            result = results[index]
+            trial, metrics = Trial(**(result.config or {})["trial"]), result.metrics or {}
+            if result.error is not None or not is_finished(trial, output):
+                outcome["failed"].append(trial.stem)
+                say(f"{trial.stem}: failed ({type(result.error).__name__}: {result.error})")
             else:
-                outcome["finished"].append(stem)
-                say(f"{stem}: {result.metrics.get('num_timesteps')} steps, evaluation success "
-                    f"{result.metrics.get('eval_success_rate')}")  # fmt: skip
+                outcome["finished"].append(trial.stem)
+                say(f"{trial.stem}: {metrics.get('num_timesteps')} steps, evaluation success "
+                    f"{metrics.get('eval_success_rate')}")  # fmt: skip
     finally:
         ray.shutdown()
     return outcome
