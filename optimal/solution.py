@@ -79,13 +79,15 @@ def read_modes(transcription: Transcription, values: Callable[[Any], Any]) -> Mo
 
 
 def values_at(problem: OptimalControlProblem, modes: ModePattern | None,
-              point: np.ndarray) -> tuple[Transcription, Callable[[Any], Any]]:
+              point: np.ndarray, transcription: Transcription | None = None
+              ) -> tuple[Transcription, Callable[[Any], Any]]:
     """(transcription, evaluator) of the NLP point ``point`` (nx,) of ``problem``.
 
-    The transcription is built with ``modes`` (None: free), so that its expressions evaluate
-    at the point (e.g. ``read_solution(*values_at(problem, solve.modes, solve.point))``).
+    The transcription (built with ``modes``, None: free, unless one of ``problem`` is given)
+    evaluates its expressions at the point (e.g.
+    ``read_solution(*values_at(problem, solve.modes, solve.point))``).
     """
-    transcription = Transcription(problem, modes=modes)
+    transcription = transcription or Transcription(problem, modes=modes)
     opti = transcription.opti
     opti.set_initial(opti.x, point)
 

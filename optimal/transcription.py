@@ -65,6 +65,14 @@ the two wheels' sticking laws duplicate constraints -- a rank-deficient Jacobian
 objective term repairs; ``Transcription.polished`` states them once.)"""
 
 
+BRAKE_SPLIT_REGULARIZATION = 1e-6
+"""Weight of sum (p+ + p-) / impulse_scale / N over the engaged intervals of a fixed mode
+pattern: there xi_B = 0 and only P_B = p+ - p- enters the dynamics, so (p+, p-) + (d, d) is a
+direction without cost that IPOPT's log barrier follows without bound (fixed-pattern solves
+then stalled at their iteration limit on the right cost). This term picks the split with
+min(p+, p-) = 0 and adds 1e-6 |P_B| (impulse units) to the cost."""
+
+
 @dataclass(frozen=True)
 class OptimalControlProblem:
     """A named instance of problem (34): model, boundary conditions, bounds, cost, grid.
@@ -89,6 +97,9 @@ class OptimalControlProblem:
         env_kwargs: (key, value) pairs for ``gym.make(env_id, ...)`` (metadata), e.g. the
             robot's ``task="effort"``.
         description: one line for humans.
+        goal_q_tolerance: |q_i(t_f) - goal| <= this for the ``goal_q`` entries [rad or m]; 0
+            imposes the goal exactly (every reference; the MPC's fallback relaxes it).
+        goal_u_tolerance: the same for ``goal_u`` [rad/s or m/s].
     """
 
     name: str
@@ -111,6 +122,8 @@ class OptimalControlProblem:
     env_id: str = ""
     env_kwargs: tuple[tuple[str, Any], ...] = ()
     description: str = ""
+    goal_q_tolerance: float = 0.0
+    goal_u_tolerance: float = 0.0
 
 
 @dataclass
@@ -220,17 +233,22 @@ class Transcription:
                 generalized += gap.interval(i, eq.gaps(qm), eq.contact_rows(qm), uk, u_next)
             if contact is not None:
                 # at rest after the last step every slip is zero: the law reduces to the cone
-                at_rest = i == big_n - 1 and set(pr.goal_u) == set(range(n))
+                at_rest = (i == big_n - 1 and set(pr.goal_u) == set(range(n))
+                           and pr.goal_u_tolerance == 0.0)
                 generalized += contact.interval(i, h, eq.contact_rows(qm), u_next, at_rest)
             opti.subject_to((eq.mass(qm) @ (u_next - uk) - generalized) / s_imp == 0)
             opti.subject_to((self.q[:, i + 1] - qm - h / 2 * u_next) / s_len == 0)
 
         opti.subject_to(self.q[:, 0] / s_len == np.asarray(pr.initial_q, dtype=float) / s_len)
         opti.subject_to(self.u[:, 0] / s_vel == np.asarray(pr.initial_u, dtype=float) / s_vel)
-        for index, value in pr.goal_q.items():
-            opti.subject_to(self.q[index, big_n] / s_len == value / s_len)
-        for index, value in pr.goal_u.items():
-            opti.subject_to(self.u[index, big_n] / s_vel == value / s_vel)
+        for end, goal, tolerance, unit in ((self.q, pr.goal_q, pr.goal_q_tolerance, s_len),
+                                           (self.u, pr.goal_u, pr.goal_u_tolerance, s_vel)):
+            for index, value in goal.items():
+                error = (end[index, big_n] - value) / unit
+                if tolerance > 0.0:
+                    opti.subject_to(opti.bounded(-tolerance / unit, error, tolerance / unit))
+                else:
+                    opti.subject_to(error == 0)
         opti.subject_to(opti.bounded(-1.0, casadi.vec(self.tau) / pr.torque_bound, 1.0))
 
         if brake is not None:
@@ -261,8 +279,11 @@ class Transcription:
             self.cost = h * casadi.sumsqr(self.tau)
             cost_unit = pr.torque_bound**2 * pr.final_time
         regularization = 0
+        if brake is not None and modes.engaged is not None:
+            regularization = BRAKE_SPLIT_REGULARIZATION * casadi.sum1(casadi.vec(
+                brake.magnitude * np.asarray(modes.engaged, dtype=float))) / s_imp
         if contact is not None:
-            regularization = TANGENT_REGULARIZATION * casadi.sumsqr(contact.tangent / s_imp)
+            regularization += TANGENT_REGULARIZATION * casadi.sumsqr(contact.tangent / s_imp)
         penalty = 0
         for pair in self.pairs:
             products = pair.a * pair.b / pair.scale
@@ -603,6 +624,7 @@ def numeric(value: Any) -> FloatArray:
 
 
 __all__ = [
+    "BRAKE_SPLIT_REGULARIZATION",
     "IMPLICIT_THETA",
     "TANGENT_REGULARIZATION",
     "OptimalControlProblem",

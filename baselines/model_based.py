@@ -1,0 +1,43 @@
+"""Model-based controller rows of the comparison: the shrinking-horizon MPC (``optimal.mpc``).
+
+``mpc_controller(env_id, task)`` is listed in ``baselines.compare.CONTROLLER_FACTORIES``; it
+plays ``ShrinkingHorizonMPC`` around the task's reference in the env configured like the
+reference's open-loop replay (one env step per transcription interval, ``env_options``), with
+twice the reference's steps for time-optimal tasks (a perturbed start may need longer than the
+optimum; the effort tasks keep their fixed horizon). Needs CasADi (the ``optimal`` extra);
+without it the row is left out.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from typing import Any
+
+from baselines.compare import REFERENCE_NAMES, Controller
+from optimal.references import load_reference
+from optimal.replay import env_options
+
+MPC = "MPC (shrinking horizon)"
+"""The label of the MPC rows."""
+
+
+def mpc_controller(env_id: str, task: str) -> Controller | None:
+    """The MPC around the reference of (env id, task); None without a reference or CasADi."""
+    name = REFERENCE_NAMES.get((env_id, task))
+    if name is None or importlib.util.find_spec("casadi") is None:
+        return None
+    from optimal.mpc import ShrinkingHorizonMPC
+
+    reference = load_reference(name)
+    options = env_options(reference)
+    options.pop("reset_noise_scale")
+    if reference.metadata["cost_kind"] == "time":
+        options["max_episode_steps"] = 2 * len(reference.tau)
+
+    def make_policy(_env: Any) -> ShrinkingHorizonMPC:
+        return ShrinkingHorizonMPC(reference)
+
+    return Controller(MPC, make_policy, options)
+
+
+__all__ = ["MPC", "mpc_controller"]

@@ -1,0 +1,326 @@
+"""Shrinking-horizon model-predictive control on the optimal-control transcription.
+
+At every env step the controller re-solves the remaining optimal-control problem from the
+measured state -- the same model definition and midpoint transcription as the references
+(``optimal.transcription``), with the mode pattern (brake schedule, stick-slip) of its previous
+plan fixed (``optimal.mode_search.solve_with_modes``), warm-started from that plan shifted by
+one interval -- and applies the first interval's torque and brake command. Where the fixed-
+pattern solve fails, the pattern is freed: the continuation's last penalty stage and polish
+(``optimal.refinement.FREEING_SCHEDULE``) from the fixed solve's last iterate; where that fails
+too, the previous plan's next control is applied open loop (``MPCStep.fallback``).
+
+Horizon: one env step is one interval (the env runs at the reference's h, ``env_options``).
+Time-optimal problems keep t_f free and re-grid the remaining plan to
+max(round(t_remaining / h), ``min_horizon``) intervals, so a start that needs longer than the
+reference gets it; effort problems have t_f fixed, N - k intervals left at step k.
+
+``ShrinkingHorizonMPC(reference)`` is a policy: ``controller(observation) -> action`` in the
+env's default Box action space (the observation is decoded into (q, u): the manipulator's
+angles from their cos/sin, unwrapped against the plan; the robot's pose from its goal offset
+and heading error, the world velocity from the body-frame one; the robot's wheel angles,
+which no dynamics depend on, from the plan), or ``controller.control(q, u)`` on a state.
+``controller.steps`` records the compute per control step. Needs CasADi.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from mdi_envs._types import FloatArray
+from mdi_envs.tasks import DIFF_DRIVE_TASK, MANIPULATOR_TASK, wrap_angle
+from optimal.continuation import Schedule, solve_continuation
+from optimal.mode_search import ModeSolve, solve_with_modes
+from optimal.modes import ModePattern
+from optimal.problems import make_problem
+from optimal.references import Reference
+from optimal.solution import SLIP_TOLERANCE, read_modes, read_solution, values_at
+from optimal.solve import SCHEDULES
+from optimal.transcription import OptimalControlProblem, Transcription
+
+MIN_HORIZON = 1
+"""Fewest intervals a time-optimal re-solve plans over. The horizon is re-gridded to keep each
+planned interval near the env step h (a plan of 4 intervals in 0.5 h, held for h each, ran
+past the goal)."""
+
+STEP_MAX_ITERATIONS = 200
+"""IPOPT's iteration limit per control step (warm-started solves take 5-40)."""
+
+GOAL_TOLERANCE_FRACTION = 0.5
+"""Where the exact goal is infeasible from the measured state (an underactuated link off its
+plan by float32 rounding cannot be steered back within a fixed pattern), the re-solve asks for
+the goal within this fraction of the task's success tolerances."""
+
+MAX_REPLAN_GROWTH = 1.5
+"""A time-optimal re-plan longer than this times the previous remaining time (plus one step)
+is a detour through another local optimum, and is not taken."""
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """A trajectory on a grid of N intervals from the current state.
+
+    Attributes:
+        q: (N+1, n). u: (N+1, n). tau: (N, m) [N m]. modes: the pattern (N intervals).
+        final_time: its duration [s].
+    """
+
+    q: FloatArray
+    u: FloatArray
+    tau: FloatArray
+    modes: ModePattern
+    final_time: float
+
+    @property
+    def num_intervals(self) -> int:
+        """N."""
+        return int(self.tau.shape[0])
+
+    def shifted(self, num_intervals: int | None = None) -> Plan:
+        """The plan from its second grid point on.
+
+        Re-gridded to ``num_intervals`` (default: one less, no re-gridding) by ``regridded``.
+        A plan of one interval continues as that interval repeated from its end state.
+        """
+        step = self.final_time / self.num_intervals
+        if self.num_intervals == 1:  # past the plan's end: hold its last interval from there
+            rest = Plan(self.q[[1, 1]], self.u[[1, 1]], self.tau, self.modes, step)
+        else:
+            rest = Plan(self.q[1:], self.u[1:], self.tau[1:],
+                        ModePattern(*(None if rows is None else rows[:, 1:]
+                                      for rows in (self.modes.engaged, self.modes.sliding))),
+                        self.final_time - step)
+        if num_intervals is None or num_intervals == rest.num_intervals:
+            return rest
+        return rest.regridded(num_intervals)
+
+    def regridded(self, num_intervals: int) -> Plan:
+        """The same plan on ``num_intervals`` intervals of equal length.
+
+        Each input and mode is the one of the old interval holding the new interval's
+        midpoint; q and u interpolate linearly.
+        """
+        old = np.linspace(0.0, 1.0, self.num_intervals + 1)
+        new = np.linspace(0.0, 1.0, num_intervals + 1)
+        midpoints = (new[:-1] + new[1:]) / 2
+        holder = np.minimum(np.searchsorted(old, midpoints, side="right") - 1,
+                            self.num_intervals - 1)
+
+        def interpolated(values: FloatArray) -> FloatArray:
+            return np.column_stack([np.interp(new, old, column) for column in values.T])
+
+        modes = ModePattern(*(None if rows is None else rows[:, holder]
+                              for rows in (self.modes.engaged, self.modes.sliding)))
+        return Plan(interpolated(self.q), interpolated(self.u), self.tau[holder], modes,
+                    self.final_time)
+
+
+@dataclass(frozen=True)
+class MPCStep:
+    """One control step.
+
+    Attributes:
+        step: env step index. horizon: intervals planned. cost: the plan's cost (t_f of the
+            remaining maneuver [s] or its effort). status: IPOPT's. iterations: IPOPT's.
+        compute_time: wall time of the step's NLP build and solves [s].
+        fallback: "" (fixed-pattern solve), "pattern shifted" (a neighbouring pattern),
+            "goal relaxed", "freed" (pattern freed too), or "open loop" (all failed: the
+            previous plan's control).
+    """
+
+    step: int
+    horizon: int
+    cost: float
+    status: str
+    iterations: int
+    compute_time: float
+    fallback: str
+
+
+class ShrinkingHorizonMPC:
+    """Shrinking-horizon MPC around a reference (see the module docstring).
+
+    Args:
+        reference: the reference whose problem is re-solved (``optimal.references``);
+            its grid step h must be the env's dt.
+        min_horizon: see ``MIN_HORIZON``. max_iterations: see ``STEP_MAX_ITERATIONS``.
+    """
+
+    def __init__(self, reference: Reference, min_horizon: int = MIN_HORIZON,
+                 max_iterations: int = STEP_MAX_ITERATIONS) -> None:
+        self.reference = reference
+        self.base = make_problem(reference.name, len(reference.tau))
+        self.time_step = reference.time_step
+        self.min_horizon = int(min_horizon)
+        self.max_iterations = int(max_iterations)
+        self.schedule = SCHEDULES.get(reference.name) or Schedule()
+        self.steps: list[MPCStep] = []
+        self._plan: Plan | None = None
+
+    def reset(self) -> None:
+        """Forget the plan and the step records (a new episode)."""
+        self.steps = []
+        self._plan = None
+
+    def __call__(self, observation: FloatArray) -> FloatArray:
+        """The env action (default Box space) for an observation of the reference's env."""
+        q, u = self.decode(np.asarray(observation, dtype=float))
+        tau, engaged = self.control(q, u)
+        action = [tau / self.base.torque_bound]
+        if engaged.size:
+            action.append(np.where(engaged, 1.0, -1.0))
+        return np.concatenate(action).astype(np.float32)
+
+    def control(self, q: FloatArray, u: FloatArray) -> tuple[FloatArray, np.ndarray]:
+        """(torques (m,) [N m], brakes engaged (k,) bool) for the state (q, u)."""
+        clock = time.perf_counter()
+        step = len(self.steps)
+        guess = self._next_guess(step)
+        if guess.num_intervals < 1:  # past a fixed horizon: nothing left to plan
+            self.steps.append(MPCStep(step, 0, 0.0, "horizon over", 0, 0.0, "open loop"))
+            return np.zeros(self.base.model.NUM_INPUTS), np.zeros(self.base.model.NUM_BRAKES,
+                                                                   dtype=bool)
+        problem = self._remaining(guess, q, u)
+        solve, plan, fallback = self._solve(problem, guess, q, u)
+        self._plan = plan
+        self.steps.append(MPCStep(
+            step, plan.num_intervals, float("nan") if solve is None else solve.cost,
+            "" if solve is None else solve.status, 0 if solve is None else solve.iterations,
+            time.perf_counter() - clock, fallback))
+        engaged = (plan.modes.engaged[:, 0] if plan.modes.engaged is not None
+                   else np.zeros(0, dtype=bool))
+        return plan.tau[0].copy(), engaged.copy()
+
+    def decode(self, observation: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(q, u) from an observation; angles unwrapped against the plan's prediction."""
+        predicted = self._predicted_q()
+        if self.base.model.NUM_BRAKES:  # the manipulator: (cos a, sin a, cos b, sin b, a', b')
+            angles = [math.atan2(observation[2 * i + 1], observation[2 * i]) for i in range(2)]
+            q = np.array([p + wrap_angle(a - p) for a, p in zip(angles, predicted, strict=True)])
+            return q, observation[4:6].copy()
+        goal = DIFF_DRIVE_TASK.goal_pose  # the robot: goal offset, heading error, body velocity
+        heading = goal[2] + math.atan2(observation[3], observation[2])
+        heading = predicted[2] + wrap_angle(heading - predicted[2])
+        cos_phi, sin_phi = math.cos(heading), math.sin(heading)
+        forward, lateral = observation[4], observation[5]
+        q = np.array([observation[0] + goal[0], observation[1] + goal[1], heading,
+                      predicted[3], predicted[4]])
+        u = np.array([cos_phi * forward - sin_phi * lateral,
+                      sin_phi * forward + cos_phi * lateral, *observation[6:9]])
+        return q, u
+
+    def _predicted_q(self) -> FloatArray:
+        if self._plan is None:
+            return np.asarray(self.reference.q[0], dtype=float)
+        return self._plan.q[1]
+
+    def _next_guess(self, step: int) -> Plan:
+        if self._plan is None:
+            return _reference_plan(self.reference)
+        if self.base.cost == "effort":
+            return self._plan.shifted()
+        remaining = self._plan.final_time - self._plan.final_time / self._plan.num_intervals
+        target = max(int(round(remaining / self.time_step)), self.min_horizon)
+        return self._plan.shifted(target)
+
+    def _remaining(self, guess: Plan, q: FloatArray, u: FloatArray) -> OptimalControlProblem:
+        """The problem from (q, u) over the guess's intervals.
+
+        t_f is free (from ~0) for time problems, the remaining time for effort ones.
+        """
+        base = self.base
+        high = base.final_time_bounds[1]
+        return dataclasses.replace(
+            base, num_intervals=guess.num_intervals, initial_q=tuple(map(float, q)),
+            initial_u=tuple(map(float, u)), final_time=guess.final_time,
+            final_time_bounds=(1e-3 * self.time_step, high))
+
+    def _solve(self, problem: OptimalControlProblem, guess: Plan, q: FloatArray,
+               u: FloatArray) -> tuple[ModeSolve | None, Plan, str]:
+        """The step's plan: fixed pattern, then the goal relaxed, then the pattern freed."""
+        transcription = Transcription(problem, modes=guess.modes)
+        start_q, start_u = guess.q.copy(), guess.u.copy()
+        start_q[0], start_u[0] = q, u
+        transcription.set_guess(start_q, start_u, guess.tau, guess.final_time)
+        opti = transcription.opti
+        initial = np.asarray(opti.value(opti.x, opti.initial()), dtype=float).ravel()
+        solve = solve_with_modes(problem, guess.modes, initial=initial,
+                                 transcription=transcription,
+                                 max_iterations=self.max_iterations)
+        if self._acceptable(solve, guess):
+            return solve, _plan_of(problem, solve, transcription), ""
+        shifted = [solve_with_modes(problem, pattern, initial=initial,
+                                    max_iterations=self.max_iterations)
+                   for _, pattern in guess.modes.neighbours(max_shift=1)
+                   if pattern.num_intervals > 1]
+        shifted = [candidate for candidate in shifted if self._acceptable(candidate, guess)]
+        if shifted:
+            best = min(shifted, key=lambda candidate: candidate.cost)
+            return best, _plan_of(problem, best), "pattern shifted"
+        relaxed = dataclasses.replace(problem, **self._goal_tolerances())
+        solve = solve_with_modes(relaxed, guess.modes, initial=initial,
+                                 max_iterations=self.max_iterations)
+        if self._acceptable(solve, guess):
+            return solve, _plan_of(relaxed, solve), "goal relaxed"
+        free = Transcription(relaxed)
+        freed = solve_continuation(free, self.schedule, initial=initial)
+        if freed.success:
+            solved = freed.transcription or free
+            point = np.asarray(freed.values(solved.opti.x), dtype=float).ravel()
+            again = solve_with_modes(relaxed, read_modes(solved, freed.values), initial=point,
+                                     max_iterations=self.max_iterations)
+            if self._acceptable(again, guess):
+                return again, _plan_of(relaxed, again), "freed"
+        return None, guess, "open loop"
+
+    def _acceptable(self, solve: ModeSolve, guess: Plan) -> bool:
+        """Whether a re-plan is taken.
+
+        It must have converged and, on time problems, not be a detour: t_f at most
+        ``MAX_REPLAN_GROWTH`` times the guess's plus one step.
+        """
+        if not solve.success:
+            return False
+        return self.base.cost != "time" or solve.final_time <= (
+            MAX_REPLAN_GROWTH * guess.final_time + self.time_step)
+
+    def _goal_tolerances(self) -> dict[str, float]:
+        """``GOAL_TOLERANCE_FRACTION`` of the task's success box, per coordinate."""
+        if self.base.model.NUM_BRAKES:
+            task = MANIPULATOR_TASK
+            q_tol, u_tol = task.angle_tolerance, task.velocity_tolerance
+        else:
+            robot = DIFF_DRIVE_TASK
+            q_tol = min(robot.position_tolerance / math.sqrt(2.0), robot.heading_tolerance)
+            u_tol = min(robot.speed_tolerance / math.sqrt(2.0), robot.yaw_rate_tolerance)
+        return {"goal_q_tolerance": GOAL_TOLERANCE_FRACTION * q_tol,
+                "goal_u_tolerance": GOAL_TOLERANCE_FRACTION * u_tol}
+
+
+def _plan_of(problem: OptimalControlProblem, solve: ModeSolve,
+             transcription: Transcription | None = None) -> Plan:
+    arrays, final_time = read_solution(*values_at(problem, solve.modes, solve.point,
+                                                  transcription))
+    return Plan(arrays["q"], arrays["u"], arrays["tau"], solve.modes, final_time)
+
+
+def _reference_plan(reference: Reference) -> Plan:
+    engaged = sliding = None
+    if reference.brake_bound is not None and reference.brake_bound.shape[1]:
+        engaged = np.asarray(reference.brake_bound > 0.0).T
+    if "slip_speed" in reference.arrays:
+        scale = make_problem(reference.name).velocity_scale
+        sliding = np.asarray(reference.arrays["slip_speed"] > SLIP_TOLERANCE * scale).T
+    return Plan(np.asarray(reference.q, dtype=float), np.asarray(reference.u, dtype=float),
+                np.asarray(reference.tau, dtype=float), ModePattern(engaged, sliding),
+                float(reference.final_time))
+
+
+__all__ = [
+    "GOAL_TOLERANCE_FRACTION", "MAX_REPLAN_GROWTH", "MIN_HORIZON", "STEP_MAX_ITERATIONS",
+    "MPCStep", "Plan", "ShrinkingHorizonMPC",
+]
