@@ -1,0 +1,76 @@
+"""The shrinking-horizon MPC on a short manipulator problem (N = 40, h ~ 0.11 s)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+casadi = pytest.importorskip("casadi")
+
+from mdi_envs.rollout import rollout  # noqa: E402
+from optimal.continuation import solve_continuation  # noqa: E402
+from optimal.modes import ModePattern  # noqa: E402
+from optimal.mpc import Plan, ShrinkingHorizonMPC  # noqa: E402
+from optimal.problems import make_problem  # noqa: E402
+from optimal.references import Reference  # noqa: E402
+from optimal.replay import env_options  # noqa: E402
+from optimal.solution import read_solution  # noqa: E402
+from optimal.transcription import Transcription  # noqa: E402
+
+SHORT_N = 40
+
+
+@pytest.fixture(scope="module")
+def short_reference() -> Reference:
+    """The N = 40 manipulator optimum of the continuation from the naive guess (~2 s)."""
+    problem = make_problem("manipulator_time", SHORT_N)
+    transcription = Transcription(problem)
+    result = solve_continuation(transcription)
+    assert result.success
+    arrays, final_time = read_solution(result.transcription or transcription, result.values)
+    return Reference("manipulator_time", arrays, {
+        "final_time": final_time, "time_step": final_time / SHORT_N,
+        "torque_bound": problem.torque_bound, "env_id": problem.env_id, "cost_kind": "time",
+        "env_kwargs": {}})
+
+
+def _play(reference: Reference, noise: float, seed: int) -> tuple[dict, ShrinkingHorizonMPC]:
+    options = env_options(reference)
+    options.update(reset_noise_scale=noise, max_episode_steps=2 * SHORT_N)
+    controller = ShrinkingHorizonMPC(reference)
+    result = rollout(reference.metadata["env_id"], controller, seed=seed, **options)
+    return result.last_info, controller
+
+
+def test_mpc_from_the_nominal_start_follows_the_reference(short_reference) -> None:  # noqa: ANN001
+    info, controller = _play(short_reference, 0.0, 0)
+    assert info["is_success"]
+    # the env stops at the goal's tolerance box, at the optimum's t_f at the latest
+    assert info["elapsed_time"] <= short_reference.final_time + 1e-9
+    first = controller.steps[0]
+    assert first.fallback == "" and first.horizon == SHORT_N
+    assert first.cost == pytest.approx(short_reference.final_time, rel=1e-6)
+
+
+def test_mpc_reaches_the_goal_from_a_perturbed_start(short_reference) -> None:  # noqa: ANN001
+    info, controller = _play(short_reference, 0.01, 1)
+    assert info["is_success"]
+    assert info["elapsed_time"] <= 1.25 * short_reference.final_time
+    assert all(step.compute_time > 0.0 for step in controller.steps)
+
+
+def test_plan_shift_and_regrid_keep_the_trajectory() -> None:
+    time = np.linspace(0.0, 1.0, 5)
+    q = np.column_stack([time, time**2])
+    plan = Plan(q, q.copy(), np.arange(4.0)[:, None],
+                ModePattern(engaged=np.array([[False, True, True, False]])), 1.0)
+    rest = plan.shifted()
+    assert rest.num_intervals == 3 and rest.final_time == pytest.approx(0.75)
+    np.testing.assert_array_equal(rest.q, q[1:])
+    assert rest.modes.engaged.tolist() == [[True, True, False]]
+    fine = plan.regridded(8)
+    np.testing.assert_allclose(fine.q[::2], q)
+    assert fine.tau[:, 0].tolist() == [0, 0, 1, 1, 2, 2, 3, 3]
+    last = Plan(q[-2:], q[-2:], np.ones((1, 1)), ModePattern(engaged=np.array([[True]])), 0.25)
+    held = last.shifted(2)
+    assert held.num_intervals == 2 and np.allclose(held.q, q[-1])
