@@ -107,6 +107,9 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
                         "the output of mdi-envs sweep)")
     parser.add_argument("--bootstrap-reps", type=int, default=None,
                         help="bootstrap replications per CI (default 2000)")
+    parser.add_argument("--mpc", action="store_true",
+                        help="also play the shrinking-horizon MPC around the reference "
+                        "(optimal.mpc; needs CasADi; 0.1-1 s of compute per env step)")
     parser.add_argument("--output", type=Path, default=Path("results/compare"),
                         help="folder for the JSON, PNG and Markdown results")
     parser.set_defaults(handler=run_compare)
@@ -129,8 +132,16 @@ def run_compare(args: argparse.Namespace) -> int:
     trained_dir = TRAINED_DIR if args.trained is None else args.trained
     comparisons = []
     for env_id, task in jobs:
+        extra = []
+        if args.mpc:
+            from baselines.model_based import mpc_controller
+
+            controller = mpc_controller(env_id, task)
+            if controller is None:
+                raise SystemExit("compare: --mpc needs CasADi (pip install 'mdi-envs[optimal]')")
+            extra.append(controller)
         comparison = compare(env_id, task, num_seeds=args.seeds, trained_dir=trained_dir,
-                             bootstrap_reps=args.bootstrap_reps,
+                             bootstrap_reps=args.bootstrap_reps, extra_controllers=extra,
                              log=lambda line: print(line, file=sys.stderr, flush=True))
         for path in write_comparison(comparison, args.output, trained_dir):
             print(f"wrote {path}", file=sys.stderr)

@@ -1,11 +1,12 @@
 """Model-based controller rows of the comparison: the shrinking-horizon MPC (``optimal.mpc``).
 
-``mpc_controller(env_id, task)`` is listed in ``baselines.compare.CONTROLLER_FACTORIES``; it
-plays ``ShrinkingHorizonMPC`` around the task's reference in the env configured like the
-reference's open-loop replay (one env step per transcription interval, ``env_options``), with
-twice the reference's steps for time-optimal tasks (a perturbed start may need longer than the
-optimum; the effort tasks keep their fixed horizon). Needs CasADi (the ``optimal`` extra);
-without it the row is left out.
+``mpc_controller(env_id, task)`` plays ``ShrinkingHorizonMPC`` around the task's reference in
+the env configured like the reference's open-loop replay (one env step per transcription
+interval, ``env_options``), with twice the reference's steps for time-optimal tasks (a
+perturbed start may need longer than the optimum; the effort tasks keep their fixed horizon).
+``mdi-envs compare ... --mpc`` adds it; it is not in ``baselines.compare.CONTROLLER_FACTORIES``,
+which every comparison and test plays, because it costs 0.1-1 s of compute per env step.
+Needs CasADi (the ``optimal`` extra); without it the row is left out.
 """
 
 from __future__ import annotations
