@@ -108,9 +108,11 @@ def search_reference(
 
     Runs ``optimal.global_search.global_search`` (``num_starts`` starts, each continued and
     mode-neighbourhood searched), refines the best to N x ``refine_factors``
-    (``optimal.refinement.refine``), and returns the reference at the coarsest level whose
-    cost changes by less than ``SHIPPED_LEVEL_CHANGE`` to the next (the finest level if none
-    does), with the search and the refinement in its metadata.
+    (``optimal.refinement.refine``), and returns the reference at the coarsest level with at
+    least the problem's default N (the grid the envs' comparisons use) whose cost changes by
+    less than ``SHIPPED_LEVEL_CHANGE`` to the next (the finest level if none does), with the
+    search and the refinement in its metadata. A search on a coarser grid than the default
+    (``num_intervals``) is cheap, and its refinement factors reach the default.
 
     Args:
         name: the problem. num_starts: of the search. refine_factors: N multiples to refine
@@ -141,8 +143,10 @@ def search_reference(
     refinement = refine(search.problem, best, refine_factors, mu_strategy=schedule.mu_strategy,
                         make=lambda n: make_problem(name, n), progress=progress)
     changes = refinement.relative_changes()
+    default_n = make_problem(name).num_intervals
     shipped = next((i for i, change in enumerate(changes)
-                    if abs(change) < SHIPPED_LEVEL_CHANGE), len(changes))
+                    if abs(change) < SHIPPED_LEVEL_CHANGE
+                    and refinement.levels[i].problem.num_intervals >= default_n), len(changes))
     level = refinement.levels[shipped]
     problem, solve = level.problem, level.solve
     arrays, final_time = read_solution(*values_at(problem, solve.modes, solve.point))
