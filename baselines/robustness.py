@@ -1,0 +1,242 @@
+"""Robustness of every controller: start perturbations and a model the controller does not know.
+
+For (env id, task) each controller -- the optimal reference open loop, optionally the MPC
+(``baselines.model_based``), and every trained seed of every algorithm (``baselines/trained``)
+-- is played from ``num_seeds`` perturbed starts under each condition:
+
+* start perturbation scale s in ``SCALES`` (the env's ``reset_noise_scale``: uniform in
+  [-s, s] rad, rad/s, m, m/s; the envs' default is 0.01);
+* model mismatch at the default scale, in the env only (the controllers keep the nominal
+  model): ``MISMATCHES`` -- link masses +-10 % (manipulator), chassis mass +-10 % and the
+  friction coefficients +-20 % (robot). Neither mission env has a restitution coefficient
+  (the brake and the wheels have no impacts), so no restitution row.
+
+Reported per controller and condition: the success rate (mean over a trained algorithm's seeds,
+with the per-seed rates) and, over the successes, the time and effort ratios to the reference.
+``python -m baselines.robustness ENV_ID|all [--task T] [--seeds N] [--mpc]`` writes
+``robustness_ENV_TASK.json``, ``.png`` (success against the perturbation scale, one curve per
+controller; success under each mismatch) and ``robustness.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from baselines.compare import (
+    REFERENCE_NAMES,
+    TRAINED_DIR,
+    Controller,
+    group_by_algorithm,
+    load_policy,
+    play,
+    reference_effort,
+    registered_controllers,
+    shipped_policies,
+    summarize,
+)
+from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulatorParameters
+from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
+from optimal.references import load_reference
+
+SCALES = (0.01, 0.03, 0.1, 0.3)
+"""Start perturbation half-widths [rad, rad/s, m, m/s]."""
+
+DEFAULT_SCALE = 0.01
+"""The envs' ``reset_noise_scale``, used with the mismatches."""
+
+MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
+DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
+
+
+def _manipulator(factor: float) -> BlockableManipulatorParameters:
+    nominal = BlockableManipulatorParameters()
+    return dataclasses.replace(nominal, link1_mass=factor * nominal.link1_mass,
+                               link2_mass=factor * nominal.link2_mass)
+
+
+def _robot(mass: float = 1.0, friction: float = 1.0) -> DiffDriveParameters:
+    nominal = DiffDriveParameters()
+    return dataclasses.replace(nominal, mass=mass * nominal.mass,
+                               wheel_friction=friction * nominal.wheel_friction,
+                               stick_friction=friction * nominal.stick_friction)
+
+
+MISMATCHES: dict[str, tuple[tuple[str, Callable[[], Any]], ...]] = {
+    MANIPULATOR: (("link masses +10 %", lambda: _manipulator(1.1)),
+                  ("link masses -10 %", lambda: _manipulator(0.9))),
+    DIFF_DRIVE: (("mass +10 %", lambda: _robot(mass=1.1)),
+                 ("mass -10 %", lambda: _robot(mass=0.9)),
+                 ("friction +20 %", lambda: _robot(friction=1.2)),
+                 ("friction -20 %", lambda: _robot(friction=0.8))),
+}
+"""Env id -> (label, parameters factory) of the env's model mismatches."""
+
+
+def controllers_for(env_id: str, task: str, mpc: bool = False,
+                    trained_dir: Path = TRAINED_DIR) -> list[tuple[str, list[Controller]]]:
+    """(label, runs) per controller: untrained ones with one run, trained ones per seed."""
+    rows = [(c.label, [c]) for c in registered_controllers(env_id, task)]
+    if mpc:
+        from baselines.model_based import mpc_controller
+
+        controller = mpc_controller(env_id, task)
+        if controller is None:
+            raise RuntimeError("the MPC needs CasADi (pip install 'mdi-envs[optimal]')")
+        rows.append((controller.label, [controller]))
+    for algo, paths in group_by_algorithm(shipped_policies(env_id, task, trained_dir)).items():
+        rows.append((algo, [load_policy(path)[0] for path in paths]))
+    return rows
+
+
+def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
+               scales: Sequence[float] = SCALES, trained_dir: Path = TRAINED_DIR,
+               log: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Play every controller under every condition (see the module docstring).
+
+    Returns:
+        {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort", "seeds",
+        "conditions": [{"label", "scale", "mismatch"}], "controllers": [{"label", "runs",
+        "results": [{"condition", "success_rate" (mean over runs), "run_success_rates",
+        "time_ratio", "effort_ratio" (means over runs with successes, None without)}]}]}.
+    """
+    if (env_id, task) not in REFERENCE_NAMES:
+        raise ValueError(f"no optimal reference for {env_id} task {task!r}")
+    say = log or (lambda _: None)
+    reference = load_reference(REFERENCE_NAMES[(env_id, task)])
+    optimal_time, optimal_effort = reference.final_time, reference_effort(reference)
+    conditions = [{"label": f"perturbation {scale:g}", "scale": float(scale), "mismatch": None}
+                  for scale in scales]
+    conditions += [{"label": label, "scale": DEFAULT_SCALE, "mismatch": label}
+                   for label, _ in MISMATCHES[env_id]]
+    factories = dict(MISMATCHES[env_id])
+    rows = []
+    for label, runs in controllers_for(env_id, task, mpc, trained_dir):
+        results = []
+        for condition in conditions:
+            summaries = []
+            for controller in runs:
+                kwargs: dict[str, Any] = {**controller.env_kwargs,
+                                          "reset_noise_scale": condition["scale"]}
+                if condition["mismatch"] is not None:
+                    kwargs["parameters"] = factories[condition["mismatch"]]()
+                episodes = [play(env_id, controller.make_policy, seed, True, **kwargs)
+                            for seed in range(num_seeds)]
+                summaries.append(summarize(episodes, optimal_time, optimal_effort))
+            rates = [s["success_rate"] for s in summaries]
+            result = {"condition": condition["label"], "success_rate": float(np.mean(rates)),
+                      "run_success_rates": rates}
+            for ratio in ("time_ratio", "effort_ratio"):
+                values = [s[ratio] for s in summaries if s[ratio] is not None]
+                result[ratio] = float(np.mean(values)) if values else None
+            results.append(result)
+            say(f"{env_id} {task} {label} [{condition['label']}]: success "
+                f"{result['success_rate']:.0%} over {len(runs)} run(s) x {num_seeds} starts")
+        rows.append({"label": label, "runs": len(runs), "results": results})
+    return {"env_id": env_id, "task": task, "reference": reference.name,
+            "optimal_time": optimal_time, "optimal_effort": optimal_effort,
+            "seeds": num_seeds, "conditions": conditions, "controllers": rows}
+
+
+def markdown_table(studies: Sequence[dict[str, Any]]) -> str:
+    """One row per env x task x controller; success (ratio over the successes) per condition."""
+    lines: list[str] = []
+    for study in studies:
+        labels = [c["label"] for c in study["conditions"]]
+        ratio_name = "time" if study["task"] == "time" else "effort"
+        lines += [f"\n{study['env_id']} {study['task']} ({study['seeds']} starts per run; "
+                  f"success, {ratio_name}/optimal over the successes)\n",
+                  "| controller | runs | " + " | ".join(labels) + " |",
+                  "|---|---|" + "---|" * len(labels)]
+        for row in study["controllers"]:
+            cells = []
+            for result in row["results"]:
+                ratio = result[f"{ratio_name}_ratio"]
+                cells.append(f"{result['success_rate']:.0%}"
+                             + ("" if ratio is None else f" ({ratio:.2f})"))
+            lines.append(f"| {row['label']} | {row['runs']} | " + " | ".join(cells) + " |")
+    return "\n".join(lines).strip()
+
+
+def plot_robustness(study: dict[str, Any], path: Path) -> Path:
+    """Success against the perturbation scale per controller, and under each mismatch."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scaled = [i for i, c in enumerate(study["conditions"]) if c["mismatch"] is None]
+    mismatched = [i for i, c in enumerate(study["conditions"]) if c["mismatch"] is not None]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
+    scales = [study["conditions"][i]["scale"] for i in scaled]
+    width = 0.8 / max(len(study["controllers"]), 1)
+    for k, row in enumerate(study["controllers"]):
+        left.plot(scales, [100 * row["results"][i]["success_rate"] for i in scaled], "o-",
+                  label=f"{row['label']} ({row['runs']} run{'s' * (row['runs'] > 1)})")
+        right.bar(np.arange(len(mismatched)) + k * width,
+                  [100 * row["results"][i]["success_rate"] for i in mismatched], width,
+                  label=row["label"])
+    left.set_xscale("log")
+    left.set_xlabel("start perturbation scale [rad, rad/s, m, m/s]")
+    left.set_ylabel("success [%]")
+    left.set_ylim(-3, 103)
+    left.set_title(f"{study['env_id'].split('/')[-1]} {study['task']}: perturbed starts")
+    left.legend(fontsize=8)
+    right.set_xticks(np.arange(len(mismatched)) + width * (len(study["controllers"]) - 1) / 2)
+    right.set_xticklabels([study["conditions"][i]["label"] for i in mismatched], fontsize=8)
+    right.set_ylabel("success [%]")
+    right.set_ylim(0, 103)
+    right.set_title(f"model mismatch (scale {DEFAULT_SCALE:g})")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m baselines.robustness ENV_ID|all [--task T] [--seeds N] [--mpc]``."""
+    parser = argparse.ArgumentParser(prog="python -m baselines.robustness",
+                                     description=(__doc__ or "").split("\n\n")[0])
+    parser.add_argument("env_id", choices=[MANIPULATOR, DIFF_DRIVE, "all"])
+    parser.add_argument("--task", choices=("time", "effort"), default=None)
+    parser.add_argument("--seeds", type=int, default=20, help="perturbed starts per run")
+    parser.add_argument("--scales", type=float, nargs="+", default=list(SCALES))
+    parser.add_argument("--mpc", action="store_true", help="include the MPC (needs CasADi)")
+    parser.add_argument("--trained", type=Path, default=TRAINED_DIR)
+    parser.add_argument("--output", type=Path, default=Path("results/robustness"))
+    args = parser.parse_args(argv)
+    if args.seeds < 1:
+        parser.error(f"--seeds must be >= 1, got {args.seeds}")
+    jobs = [key for key in REFERENCE_NAMES
+            if args.env_id in ("all", key[0]) and args.task in (None, key[1])]
+    if not jobs:
+        parser.error(f"{args.env_id} has no task {args.task!r}")
+    studies = []
+    for env_id, task in jobs:
+        study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
+                           log=lambda line: print(line, file=sys.stderr, flush=True))
+        stem = f"robustness_{env_id.split('/')[-1]}_{task}"
+        args.output.mkdir(parents=True, exist_ok=True)
+        (args.output / f"{stem}.json").write_text(json.dumps(study, indent=1))
+        plot_robustness(study, args.output / f"{stem}.png")
+        studies.append(study)
+    table = markdown_table(studies)
+    (args.output / "robustness.md").write_text(table + "\n")
+    print(table)
+    return 0
+
+
+__all__ = ["DEFAULT_SCALE", "MISMATCHES", "SCALES", "controllers_for", "main", "markdown_table",
+           "plot_robustness", "robustness"]
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,48 @@
+"""The robustness study: conditions, the env-only model mismatch, table and plot."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+from baselines.robustness import MISMATCHES, main, robustness  # noqa: E402
+from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters  # noqa: E402
+
+ROBOT = "mdi_envs/DiffDriveRobot-v0"
+
+
+def test_mismatches_change_only_the_named_parameters() -> None:
+    nominal = DiffDriveParameters()
+    changed = dict(MISMATCHES[ROBOT])["friction -20 %"]()
+    assert changed.wheel_friction == pytest.approx(0.8 * nominal.wheel_friction)
+    assert changed.stick_friction == pytest.approx(0.8 * nominal.stick_friction)
+    assert changed.mass == nominal.mass
+    heavier = dict(MISMATCHES[ROBOT])["mass +10 %"]()
+    assert heavier.mass == pytest.approx(1.1 * nominal.mass)
+
+
+def test_open_loop_reference_is_played_under_every_condition(tmp_path: Path) -> None:
+    study = robustness(ROBOT, "time", num_seeds=1, scales=(0.0, 0.3), trained_dir=tmp_path)
+    labels = [c["label"] for c in study["conditions"]]
+    assert labels[:2] == ["perturbation 0", "perturbation 0.3"] and len(labels) == 6
+    (row,) = study["controllers"]  # no trained policies in tmp_path: the reference only
+    by_condition = {r["condition"]: r for r in row["results"]}
+    # from the unperturbed start the open-loop optimum reaches the goal at its own t_f
+    assert by_condition["perturbation 0"]["success_rate"] == 1.0
+    assert by_condition["perturbation 0"]["time_ratio"] == pytest.approx(1.0, abs=1e-6)
+    # 0.3 m / rad of start error is far outside what open loop can absorb
+    assert by_condition["perturbation 0.3"]["success_rate"] == 0.0
+
+
+def test_cli_writes_json_plot_and_table(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert main([ROBOT, "--task", "effort", "--seeds", "1", "--scales", "0.01",
+                 "--trained", str(tmp_path), "--output", str(out)]) == 0
+    study = json.loads((out / "robustness_DiffDriveRobot-v0_effort.json").read_text())
+    assert study["task"] == "effort" and study["seeds"] == 1
+    assert (out / "robustness_DiffDriveRobot-v0_effort.png").stat().st_size > 0
+    assert "| optimal (open loop) | 1 |" in (out / "robustness.md").read_text()
