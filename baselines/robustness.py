@@ -98,8 +98,11 @@ def controllers_for(env_id: str, task: str, mpc: bool = False,
 
 def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                scales: Sequence[float] = SCALES, trained_dir: Path = TRAINED_DIR,
-               log: Callable[[str], None] | None = None) -> dict[str, Any]:
+               log: Callable[[str], None] | None = None,
+               mismatches: bool = True) -> dict[str, Any]:
     """Play every controller under every condition (see the module docstring).
+
+    ``mismatches=False`` plays the perturbation scales only.
 
     Returns:
         {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort", "seeds",
@@ -115,7 +118,7 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
     conditions = [{"label": f"perturbation {scale:g}", "scale": float(scale), "mismatch": None}
                   for scale in scales]
     conditions += [{"label": label, "scale": DEFAULT_SCALE, "mismatch": label}
-                   for label, _ in MISMATCHES[env_id]]
+                   for label, _ in MISMATCHES[env_id] if mismatches]
     factories = dict(MISMATCHES[env_id])
     rows = []
     for label, runs in controllers_for(env_id, task, mpc, trained_dir):
@@ -210,6 +213,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seeds", type=int, default=20, help="perturbed starts per run")
     parser.add_argument("--scales", type=float, nargs="+", default=list(SCALES))
     parser.add_argument("--mpc", action="store_true", help="include the MPC (needs CasADi)")
+    parser.add_argument("--mismatch", action=argparse.BooleanOptionalAction, default=True,
+                        help="also play the model mismatches (default: yes)")
     parser.add_argument("--trained", type=Path, default=TRAINED_DIR)
     parser.add_argument("--output", type=Path, default=Path("results/robustness"))
     args = parser.parse_args(argv)
@@ -222,7 +227,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     studies = []
     for env_id, task in jobs:
         study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
-                           log=lambda line: print(line, file=sys.stderr, flush=True))
+                           log=lambda line: print(line, file=sys.stderr, flush=True),
+                           mismatches=args.mismatch)
         stem = f"robustness_{env_id.split('/')[-1]}_{task}"
         args.output.mkdir(parents=True, exist_ok=True)
         (args.output / f"{stem}.json").write_text(json.dumps(study, indent=1))
