@@ -88,7 +88,8 @@ def solve_problem(
     starts = [{"guess_final_time": s["guess_final_time"], "cost": s["cost"],
                "converged": s["converged"], "solve_time": s["solve_time"]} for s in solved]
     metadata = _metadata(problem, best["cost"], final_time, best["converged"])
-    metadata.update(history=best["history"], guess_final_time=problem.final_time, starts=starts,
+    metadata.update(history=best["history"], residual=best["history"][-1]["residual"],
+                    guess_final_time=problem.final_time, starts=starts,
                     solve_time=sum(entry["solve_time"] for entry in starts),
                     total_time=total_time, workers=workers)
     return _verified(Reference(name, arrays, metadata), progress)
