@@ -74,6 +74,9 @@ def plot_search(reference: Reference, directory: Path | str) -> Path:
     right.plot([shipped["num_intervals"]], [shipped["cost"]], "r*", markersize=12,
                label="shipped")
     right.set_xscale("log", base=2)
+    right.set_xticks([lv["num_intervals"] for lv in levels],
+                     [str(lv["num_intervals"]) for lv in levels])
+    right.minorticks_off()
     right.set_xlabel("N (intervals)")
     right.set_ylabel(f"{label} [{unit}]")
     right.set_title("mesh refinement")
