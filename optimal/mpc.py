@@ -179,7 +179,7 @@ class ShrinkingHorizonMPC:
         """(torques (m,) [N m], brakes engaged (k,) bool) for the state (q, u)."""
         clock = time.perf_counter()
         step = len(self.steps)
-        guess = self._next_guess(step)
+        guess = self._next_guess()
         if guess.num_intervals < 1:  # past a fixed horizon: nothing left to plan
             self.steps.append(MPCStep(step, 0, 0.0, "horizon over", 0, 0.0, "open loop"))
             return np.zeros(self.base.model.NUM_INPUTS), np.zeros(self.base.model.NUM_BRAKES,
@@ -218,7 +218,7 @@ class ShrinkingHorizonMPC:
             return np.asarray(self.reference.q[0], dtype=float)
         return self._plan.q[1]
 
-    def _next_guess(self, step: int) -> Plan:
+    def _next_guess(self) -> Plan:
         if self._plan is None:
             return _reference_plan(self.reference)
         if self.base.cost == "effort":
