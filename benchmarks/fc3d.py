@@ -106,6 +106,9 @@ def run(output: Path, quick: bool) -> str:
         "run_time_s": log.elapsed,
     }
     report.write_json(record, output / "fc3d.json")
+    if not rows:  # no peer data here: nothing to draw (a log axis of no values fails)
+        log(f"done in {log.elapsed:.0f} s; wrote fc3d.json (no problems) to {output}")
+        return markdown(record)
     plot(rows, output / "fc3d.png")
     log(f"done in {log.elapsed:.0f} s; wrote fc3d.json and fc3d.png to {output}")
     return markdown(record)
