@@ -129,7 +129,7 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                 kwargs: dict[str, Any] = {**controller.env_kwargs,
                                           "reset_noise_scale": condition["scale"]}
                 if condition["mismatch"] is not None:
-                    kwargs["parameters"] = factories[condition["mismatch"]]()
+                    kwargs["parameters"] = factories[str(condition["mismatch"])]()
                 episodes = [play(env_id, controller.make_policy, seed, True, **kwargs)
                             for seed in range(num_seeds)]
                 summaries.append(summarize(episodes, optimal_time, optimal_effort))

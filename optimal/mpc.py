@@ -261,7 +261,9 @@ class ShrinkingHorizonMPC:
         if shifted:
             best = min(shifted, key=lambda candidate: candidate.cost)
             return best, _plan_of(problem, best), "pattern shifted"
-        relaxed = dataclasses.replace(problem, **self._goal_tolerances())
+        q_tolerance, u_tolerance = self._goal_tolerances()
+        relaxed = dataclasses.replace(problem, goal_q_tolerance=q_tolerance,
+                                      goal_u_tolerance=u_tolerance)
         solve = solve_with_modes(relaxed, guess.modes, initial=initial,
                                  max_iterations=self.max_iterations)
         if self._acceptable(solve, guess):
@@ -288,8 +290,8 @@ class ShrinkingHorizonMPC:
         return self.base.cost != "time" or solve.final_time <= (
             MAX_REPLAN_GROWTH * guess.final_time + self.time_step)
 
-    def _goal_tolerances(self) -> dict[str, float]:
-        """``GOAL_TOLERANCE_FRACTION`` of the task's success box, per coordinate."""
+    def _goal_tolerances(self) -> tuple[float, float]:
+        """(q, u) tolerances: ``GOAL_TOLERANCE_FRACTION`` of the task's success box."""
         if self.base.model.NUM_BRAKES:
             task = MANIPULATOR_TASK
             q_tol, u_tol = task.angle_tolerance, task.velocity_tolerance
@@ -297,8 +299,7 @@ class ShrinkingHorizonMPC:
             robot = DIFF_DRIVE_TASK
             q_tol = min(robot.position_tolerance / math.sqrt(2.0), robot.heading_tolerance)
             u_tol = min(robot.speed_tolerance / math.sqrt(2.0), robot.yaw_rate_tolerance)
-        return {"goal_q_tolerance": GOAL_TOLERANCE_FRACTION * q_tol,
-                "goal_u_tolerance": GOAL_TOLERANCE_FRACTION * u_tol}
+        return GOAL_TOLERANCE_FRACTION * q_tol, GOAL_TOLERANCE_FRACTION * u_tol
 
 
 def _plan_of(problem: OptimalControlProblem, solve: ModeSolve,
