@@ -4,6 +4,7 @@
 the env configured like the reference's open-loop replay (one env step per transcription
 interval, ``env_options``), with twice the reference's steps for time-optimal tasks (a
 perturbed start may need longer than the optimum; the effort tasks keep their fixed horizon).
+One controller serves every episode of a row, so the NLPs it built are reused.
 ``mdi-envs compare ... --mpc`` adds it; it is not in ``baselines.compare.CONTROLLER_FACTORIES``,
 which every comparison and test plays, because it costs 0.1-1 s of compute per env step.
 Needs CasADi (the ``optimal`` extra); without it the row is left out.
@@ -35,8 +36,11 @@ def mpc_controller(env_id: str, task: str) -> Controller | None:
     if reference.metadata["cost_kind"] == "time":
         options["max_episode_steps"] = 2 * len(reference.tau)
 
+    controller = ShrinkingHorizonMPC(reference)
+
     def make_policy(_env: Any) -> ShrinkingHorizonMPC:
-        return ShrinkingHorizonMPC(reference)
+        controller.reset()  # a new episode: the plan goes, the built NLPs stay
+        return controller
 
     return Controller(MPC, make_policy, options)
 

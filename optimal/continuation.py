@@ -128,7 +128,7 @@ def solve_continuation(
     """
     schedule = schedule or Schedule()
     opti = transcription.opti
-    set_solver(opti, schedule, BOUND_RELAXATION)
+    set_solver(transcription, schedule, BOUND_RELAXATION)
     if initial is None:
         transcription.set_naive_guess()
     else:
@@ -149,7 +149,7 @@ def solve_continuation(
                 opti.set_initial(opti.x, point)
             else:
                 _fix_active_sets(transcription, values)
-            set_solver(opti, schedule, POLISH_BOUND_RELAXATION)
+            set_solver(transcription, schedule, POLISH_BOUND_RELAXATION)
         opti.set_value(transcription.rho, penalty)
         opti.set_value(transcription.relaxation, relaxation)
         start = time.perf_counter()
@@ -185,9 +185,20 @@ def solve_continuation(
                               transcription=transcription)
 
 
-def set_solver(opti: Any, schedule: Schedule, bound_relaxation: float) -> None:
-    """IPOPT with CasADi's exact Hessian, quiet, with the schedule's limits."""
-    opti.solver("ipopt", {"expand": True, "print_time": False},
+def set_solver(transcription: Transcription, schedule: Schedule,
+               bound_relaxation: float) -> None:
+    """IPOPT with CasADi's exact Hessian, quiet, with the schedule's limits.
+
+    Setting a solver makes CasADi rebuild (expand and bake) the NLP at the next solve, about
+    as long as a warm-started solve: when the transcription's solver already has these
+    settings, nothing is done (``Transcription.solver_settings``), so a reused NLP is solved
+    again at once.
+    """
+    settings = (schedule, bound_relaxation)
+    if transcription.solver_settings == settings:
+        return
+    transcription.solver_settings = settings
+    transcription.opti.solver("ipopt", {"expand": True, "print_time": False},
                 {"print_level": 0, "max_iter": schedule.max_iterations,
                  "tol": schedule.tolerance, "acceptable_tol": 1e-7,
                  "mu_strategy": schedule.mu_strategy, "bound_relax_factor": bound_relaxation,

@@ -91,7 +91,7 @@ def solve_with_modes(problem: OptimalControlProblem, modes: ModePattern,
     start = time.perf_counter()
     transcription = transcription or Transcription(problem, modes=modes)
     opti = transcription.opti
-    set_solver(opti, Schedule(max_iterations=max_iterations, mu_strategy=mu_strategy),
+    set_solver(transcription, Schedule(max_iterations=max_iterations, mu_strategy=mu_strategy),
                POLISH_BOUND_RELAXATION)
     opti.set_value(transcription.rho, 0.0)
     opti.set_value(transcription.relaxation, POLISH_RELAXATION)

@@ -4,10 +4,15 @@ At every env step the controller re-solves the remaining optimal-control problem
 measured state -- the same model definition and midpoint transcription as the references
 (``optimal.transcription``), with the mode pattern (brake schedule, stick-slip) of its previous
 plan fixed (``optimal.mode_search.solve_with_modes``), warm-started from that plan shifted by
-one interval -- and applies the first interval's torque and brake command. Where the fixed-
-pattern solve fails, the pattern is freed: the continuation's last penalty stage and polish
-(``optimal.refinement.FREEING_SCHEDULE``) from the fixed solve's last iterate; where that fails
-too, the previous plan's next control is applied open loop (``MPCStep.fallback``).
+one interval -- and applies the first interval's torque and brake command. Each NLP is built
+once per (intervals, pattern, goal relaxed) with the start as a parameter
+(``Transcription(parametric_start=True)``) and kept (``NLP_CACHE_SIZE``): building costs more
+than a warm-started solve, and episodes from nearby starts revisit the same keys. Where the
+fixed-pattern solve fails, the fallbacks are, in order: the neighbouring patterns (switches
+shifted by one interval, phases merged or split), the goal relaxed to ``GOAL_TOLERANCE_FRACTION``
+of the success box, the pattern freed (the reference's continuation schedule from the fixed
+solve's last iterate, then re-solved with the modes it found), and last the previous plan's
+next control open loop (``MPCStep.fallback``).
 
 Horizon: one env step is one interval (the env runs at the reference's h, ``env_options``).
 Time-optimal problems keep t_f free and re-grid the remaining plan to
@@ -27,6 +32,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,7 +46,7 @@ from optimal.problems import make_problem
 from optimal.references import Reference
 from optimal.solution import SLIP_TOLERANCE, read_modes, read_solution, values_at
 from optimal.solve import SCHEDULES
-from optimal.transcription import OptimalControlProblem, Transcription
+from optimal.transcription import Transcription
 
 MIN_HORIZON = 1
 """Fewest intervals a time-optimal re-solve plans over. The horizon is re-gridded to keep each
@@ -55,6 +61,17 @@ GOAL_TOLERANCE_FRACTION = 0.5
 plan by float32 rounding cannot be steered back within a fixed pattern), the re-solve asks for
 the goal within this fraction of the task's success tolerances."""
 
+PLAN_IMPULSES = ("tangent_impulse", "slip_speed")
+"""The per-interval solution arrays a plan carries into the next warm start: the robot's
+friction (``Transcription.set_guess``). The brake impulses are not carried: warm-started with
+them, the nominal N = 40 manipulator run left its plan at step 24 and took 7 % longer."""
+
+NLP_CACHE_SIZE = 400
+"""Fixed-pattern NLPs a controller keeps (least recently used dropped; about 1-3 MB each).
+Building one costs 0.5-0.8 s at 120 intervals and its first solve another 0.2 s (CasADi's
+expand); a warm-started re-solve of a kept one about 0.1 s. Episodes from nearby starts visit
+the same (intervals, pattern) keys, so from the second episode on most steps reuse an NLP."""
+
 MAX_REPLAN_GROWTH = 1.5
 """A time-optimal re-plan longer than this times the previous remaining time (plus one step)
 is a detour through another local optimum, and is not taken."""
@@ -67,6 +84,8 @@ class Plan:
     Attributes:
         q: (N+1, n). u: (N+1, n). tau: (N, m) [N m]. modes: the pattern (N intervals).
         final_time: its duration [s].
+        impulses: per-interval impulses and slip speeds by output name (``PLAN_IMPULSES``),
+            each (N, ·), the rest of the warm start (``Transcription.set_guess``).
     """
 
     q: FloatArray
@@ -74,6 +93,7 @@ class Plan:
     tau: FloatArray
     modes: ModePattern
     final_time: float
+    impulses: dict[str, FloatArray] = dataclasses.field(default_factory=dict)
 
     @property
     def num_intervals(self) -> int:
@@ -88,12 +108,14 @@ class Plan:
         """
         step = self.final_time / self.num_intervals
         if self.num_intervals == 1:  # past the plan's end: hold its last interval from there
-            rest = Plan(self.q[[1, 1]], self.u[[1, 1]], self.tau, self.modes, step)
+            rest = Plan(self.q[[1, 1]], self.u[[1, 1]], self.tau, self.modes, step,
+                        self.impulses)
         else:
             rest = Plan(self.q[1:], self.u[1:], self.tau[1:],
                         ModePattern(*(None if rows is None else rows[:, 1:]
                                       for rows in (self.modes.engaged, self.modes.sliding))),
-                        self.final_time - step)
+                        self.final_time - step,
+                        {key: value[1:] for key, value in self.impulses.items()})
         if num_intervals is None or num_intervals == rest.num_intervals:
             return rest
         return rest.regridded(num_intervals)
@@ -101,8 +123,9 @@ class Plan:
     def regridded(self, num_intervals: int) -> Plan:
         """The same plan on ``num_intervals`` intervals of equal length.
 
-        Each input and mode is the one of the old interval holding the new interval's
-        midpoint; q and u interpolate linearly.
+        Each input, impulse and mode is the one of the old interval holding the new
+        interval's midpoint (impulses scaled by the ratio of the interval lengths, slip speeds
+        not); q and u interpolate linearly.
         """
         old = np.linspace(0.0, 1.0, self.num_intervals + 1)
         new = np.linspace(0.0, 1.0, num_intervals + 1)
@@ -115,8 +138,11 @@ class Plan:
 
         modes = ModePattern(*(None if rows is None else rows[:, holder]
                               for rows in (self.modes.engaged, self.modes.sliding)))
+        ratio = self.num_intervals / num_intervals
+        impulses = {key: value[holder] * (1.0 if key == "slip_speed" else ratio)
+                    for key, value in self.impulses.items()}
         return Plan(interpolated(self.q), interpolated(self.u), self.tau[holder], modes,
-                    self.final_time)
+                    self.final_time, impulses)
 
 
 @dataclass(frozen=True)
@@ -148,6 +174,10 @@ class ShrinkingHorizonMPC:
         reference: the reference whose problem is re-solved (``optimal.references``);
             its grid step h must be the env's dt.
         min_horizon: see ``MIN_HORIZON``. max_iterations: see ``STEP_MAX_ITERATIONS``.
+
+    Attributes:
+        steps: the ``MPCStep`` records of this episode. nlps_built: NLPs built so far (the
+            rest of the fixed-pattern solves reused one, ``NLP_CACHE_SIZE``).
     """
 
     def __init__(self, reference: Reference, min_horizon: int = MIN_HORIZON,
@@ -159,10 +189,12 @@ class ShrinkingHorizonMPC:
         self.max_iterations = int(max_iterations)
         self.schedule = SCHEDULES.get(reference.name) or Schedule()
         self.steps: list[MPCStep] = []
+        self.nlps_built = 0
         self._plan: Plan | None = None
+        self._nlps: OrderedDict[tuple[int, bytes, bool], Transcription] = OrderedDict()
 
     def reset(self) -> None:
-        """Forget the plan and the step records (a new episode)."""
+        """Forget the plan and the step records (a new episode); the built NLPs are kept."""
         self.steps = []
         self._plan = None
 
@@ -184,8 +216,7 @@ class ShrinkingHorizonMPC:
             self.steps.append(MPCStep(step, 0, 0.0, "horizon over", 0, 0.0, "open loop"))
             return np.zeros(self.base.model.NUM_INPUTS), np.zeros(self.base.model.NUM_BRAKES,
                                                                    dtype=bool)
-        problem = self._remaining(guess, q, u)
-        solve, plan, fallback = self._solve(problem, guess, q, u)
+        solve, plan, fallback = self._solve(guess, q, u)
         self._plan = plan
         self.steps.append(MPCStep(
             step, plan.num_intervals, float("nan") if solve is None else solve.cost,
@@ -227,56 +258,75 @@ class ShrinkingHorizonMPC:
         target = max(int(round(remaining / self.time_step)), self.min_horizon)
         return self._plan.shifted(target)
 
-    def _remaining(self, guess: Plan, q: FloatArray, u: FloatArray) -> OptimalControlProblem:
-        """The problem from (q, u) over the guess's intervals.
+    def _nlp(self, modes: ModePattern, relaxed: bool, q: FloatArray,
+             u: FloatArray) -> Transcription:
+        """The fixed-pattern NLP of the remaining problem from (q, u), built once per key.
 
-        t_f is free (from ~0) for time problems, the remaining time for effort ones.
+        The key is (intervals, pattern, goal relaxed); the start is the NLP's parameter. Time
+        problems keep t_f free (from ~0), effort problems fix it to the intervals left times h.
+        The least recently used NLP is dropped past ``NLP_CACHE_SIZE``.
         """
-        base = self.base
-        high = base.final_time_bounds[1]
-        return dataclasses.replace(
-            base, num_intervals=guess.num_intervals, initial_q=tuple(map(float, q)),
-            initial_u=tuple(map(float, u)), final_time=guess.final_time,
-            final_time_bounds=(1e-3 * self.time_step, high))
+        key = (modes.num_intervals, modes.key(), relaxed)
+        transcription = self._nlps.pop(key, None)
+        if transcription is None:
+            problem = dataclasses.replace(
+                self.base, num_intervals=modes.num_intervals,
+                final_time=modes.num_intervals * self.time_step,
+                final_time_bounds=(1e-3 * self.time_step, self.base.final_time_bounds[1]))
+            if relaxed:
+                q_tolerance, u_tolerance = self._goal_tolerances()
+                problem = dataclasses.replace(problem, goal_q_tolerance=q_tolerance,
+                                              goal_u_tolerance=u_tolerance)
+            transcription = Transcription(problem, modes=modes, parametric_start=True)
+            self.nlps_built += 1
+        self._nlps[key] = transcription
+        if len(self._nlps) > NLP_CACHE_SIZE:
+            self._nlps.popitem(last=False)
+        transcription.set_start(q, u)
+        return transcription
 
-    def _solve(self, problem: OptimalControlProblem, guess: Plan, q: FloatArray,
-               u: FloatArray) -> tuple[ModeSolve | None, Plan, str]:
-        """The step's plan: fixed pattern, then the goal relaxed, then the pattern freed."""
-        transcription = Transcription(problem, modes=guess.modes)
-        start_q, start_u = guess.q.copy(), guess.u.copy()
-        start_q[0], start_u[0] = q, u
-        transcription.set_guess(start_q, start_u, guess.tau, guess.final_time)
-        opti = transcription.opti
-        initial = np.asarray(opti.value(opti.x, opti.initial()), dtype=float).ravel()
-        solve = solve_with_modes(problem, guess.modes, initial=initial,
+    def _fixed(self, modes: ModePattern, relaxed: bool, q: FloatArray, u: FloatArray,
+               initial: FloatArray) -> tuple[ModeSolve, Transcription]:
+        """A fixed-pattern solve of the remaining problem from the NLP point ``initial``."""
+        transcription = self._nlp(modes, relaxed, q, u)
+        solve = solve_with_modes(transcription.problem, modes, initial=initial,
                                  transcription=transcription,
                                  max_iterations=self.max_iterations)
+        return solve, transcription
+
+    def _solve(self, guess: Plan, q: FloatArray,
+               u: FloatArray) -> tuple[ModeSolve | None, Plan, str]:
+        """The step's plan: fixed pattern, then the goal relaxed, then the pattern freed."""
+        transcription = self._nlp(guess.modes, False, q, u)
+        start_q, start_u = guess.q.copy(), guess.u.copy()
+        start_q[0], start_u[0] = q, u
+        transcription.set_guess(start_q, start_u, guess.tau, guess.final_time, guess.impulses)
+        opti = transcription.opti
+        initial = np.asarray(opti.value(opti.x, opti.initial()), dtype=float).ravel()
+        solve, transcription = self._fixed(guess.modes, False, q, u, initial)
         if self._acceptable(solve, guess):
-            return solve, _plan_of(problem, solve, transcription), ""
-        shifted = [solve_with_modes(problem, pattern, initial=initial,
-                                    max_iterations=self.max_iterations)
-                   for _, pattern in guess.modes.neighbours(max_shift=1)
-                   if pattern.num_intervals > 1]
-        shifted = [candidate for candidate in shifted if self._acceptable(candidate, guess)]
-        if shifted:
-            best = min(shifted, key=lambda candidate: candidate.cost)
-            return best, _plan_of(problem, best), "pattern shifted"
-        q_tolerance, u_tolerance = self._goal_tolerances()
-        relaxed = dataclasses.replace(problem, goal_q_tolerance=q_tolerance,
-                                      goal_u_tolerance=u_tolerance)
-        solve = solve_with_modes(relaxed, guess.modes, initial=initial,
-                                 max_iterations=self.max_iterations)
+            return solve, _plan_of(solve, transcription), ""
+        if guess.num_intervals > 1:
+            candidates = [self._fixed(pattern, False, q, u, initial)
+                          for _, pattern in guess.modes.neighbours(max_shift=1)]
+            accepted = [pair for pair in candidates if self._acceptable(pair[0], guess)]
+            if accepted:
+                best = min(accepted, key=lambda pair: pair[0].cost)
+                return best[0], _plan_of(*best), "pattern shifted"
+        solve, transcription = self._fixed(guess.modes, True, q, u, initial)
         if self._acceptable(solve, guess):
-            return solve, _plan_of(relaxed, solve), "goal relaxed"
-        free = Transcription(relaxed)
+            return solve, _plan_of(solve, transcription), "goal relaxed"
+        relaxed = transcription.problem
+        free = Transcription(relaxed, parametric_start=True)
+        free.set_start(q, u)
         freed = solve_continuation(free, self.schedule, initial=initial)
         if freed.success:
             solved = freed.transcription or free
             point = np.asarray(freed.values(solved.opti.x), dtype=float).ravel()
-            again = solve_with_modes(relaxed, read_modes(solved, freed.values), initial=point,
-                                     max_iterations=self.max_iterations)
+            again, transcription = self._fixed(read_modes(solved, freed.values), True, q, u,
+                                               point)
             if self._acceptable(again, guess):
-                return again, _plan_of(relaxed, again), "freed"
+                return again, _plan_of(again, transcription), "freed"
         return None, guess, "open loop"
 
     def _acceptable(self, solve: ModeSolve, guess: Plan) -> bool:
@@ -302,11 +352,11 @@ class ShrinkingHorizonMPC:
         return GOAL_TOLERANCE_FRACTION * q_tol, GOAL_TOLERANCE_FRACTION * u_tol
 
 
-def _plan_of(problem: OptimalControlProblem, solve: ModeSolve,
-             transcription: Transcription | None = None) -> Plan:
-    arrays, final_time = read_solution(*values_at(problem, solve.modes, solve.point,
-                                                  transcription))
-    return Plan(arrays["q"], arrays["u"], arrays["tau"], solve.modes, final_time)
+def _plan_of(solve: ModeSolve, transcription: Transcription) -> Plan:
+    arrays, final_time = read_solution(*values_at(transcription.problem, solve.modes,
+                                                  solve.point, transcription))
+    return Plan(arrays["q"], arrays["u"], arrays["tau"], solve.modes, final_time,
+                {key: arrays[key] for key in PLAN_IMPULSES if key in arrays})
 
 
 def _reference_plan(reference: Reference) -> Plan:
@@ -318,10 +368,13 @@ def _reference_plan(reference: Reference) -> Plan:
         sliding = np.asarray(reference.arrays["slip_speed"] > SLIP_TOLERANCE * scale).T
     return Plan(np.asarray(reference.q, dtype=float), np.asarray(reference.u, dtype=float),
                 np.asarray(reference.tau, dtype=float), ModePattern(engaged, sliding),
-                float(reference.final_time))
+                float(reference.final_time),
+                {key: np.asarray(reference.arrays[key], dtype=float)
+                 for key in PLAN_IMPULSES if key in reference.arrays})
 
 
 __all__ = [
-    "GOAL_TOLERANCE_FRACTION", "MAX_REPLAN_GROWTH", "MIN_HORIZON", "STEP_MAX_ITERATIONS",
+    "GOAL_TOLERANCE_FRACTION", "MAX_REPLAN_GROWTH", "MIN_HORIZON", "NLP_CACHE_SIZE",
+    "PLAN_IMPULSES", "STEP_MAX_ITERATIONS",
     "MPCStep", "Plan", "ShrinkingHorizonMPC",
 ]

@@ -59,6 +59,22 @@ def test_mpc_reaches_the_goal_from_a_perturbed_start(short_reference) -> None:  
     assert all(step.compute_time > 0.0 for step in controller.steps)
 
 
+def test_a_second_episode_reuses_the_built_nlps(short_reference) -> None:  # noqa: ANN001
+    options = env_options(short_reference)
+    options.update(reset_noise_scale=0.01, max_episode_steps=2 * SHORT_N)
+    controller = ShrinkingHorizonMPC(short_reference)
+    episodes = []
+    for _ in range(2):
+        controller.reset()
+        result = rollout(short_reference.metadata["env_id"], controller, seed=2, **options)
+        episodes.append((result.last_info["elapsed_time"], [s.cost for s in controller.steps],
+                         controller.nlps_built))
+    (first_time, first_costs, built), (second_time, second_costs, built_again) = episodes
+    assert built_again == built  # every (intervals, pattern) of the replay was kept
+    assert second_time == first_time
+    np.testing.assert_allclose(second_costs, first_costs, rtol=1e-6)
+
+
 def test_plan_shift_and_regrid_keep_the_trajectory() -> None:
     time = np.linspace(0.0, 1.0, 5)
     q = np.column_stack([time, time**2])
