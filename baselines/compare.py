@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import importlib
 import json
+import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
@@ -101,6 +102,8 @@ class Episode:
         num_steps: env steps. solver_failures: steps whose contact solve did not converge.
         time: (num_steps + 1,) [s]. q: (num_steps + 1, n) coordinates.
         schedule: (num_steps,) brake engaged (0/1) or slip mode (2/3/5) per step.
+        compute_per_step: mean wall time of one policy call [s] (an MPC's re-solve, a
+            network's forward pass).
     """
 
     seed: int
@@ -114,6 +117,7 @@ class Episode:
     time: np.ndarray
     q: np.ndarray
     schedule: np.ndarray
+    compute_per_step: float = 0.0
 
     def scores(self) -> dict[str, Any]:
         """The scalar fields (for JSON)."""
@@ -134,7 +138,15 @@ def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: 
     env = gym.make(env_id, **env_kwargs)
     policy = make_policy(env)
     env.close()
-    result = rollout(env_id, policy, seed=seed, **env_kwargs)
+    compute = []
+
+    def timed(observation: Any) -> Any:
+        start = time.perf_counter()
+        action = policy(observation)
+        compute.append(time.perf_counter() - start)
+        return action
+
+    result = rollout(env_id, timed, seed=seed, **env_kwargs)
     info = result.last_info
     dt = float(info["elapsed_time"]) / max(result.num_steps, 1)
     key = SCHEDULE_KEYS.get(env_id)
@@ -146,6 +158,7 @@ def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: 
         num_steps=result.num_steps,
         solver_failures=sum(int(step["solver_status"] != 0) for step in result.infos),
         time=dt * np.arange(result.num_steps + 1), q=result.q, schedule=schedule,
+        compute_per_step=float(np.mean(compute)) if compute else 0.0,
     )
 
 
@@ -224,7 +237,8 @@ def summarize(episodes: Sequence[Episode], optimal_time: float, optimal_effort: 
     Returns:
         {"episodes", "success_rate", "time_ratio" (mean), "time_ratio_median",
         "effort_ratio" (mean), "mean_time" [s], "mean_effort" [N^2 m^2 s],
-        "solver_failures"}; the ratios are None without a success.
+        "solver_failures", "compute_per_step" [s] (mean over the episodes)}; the ratios are
+        None without a success.
     """
     wins = [e for e in episodes if e.is_success]
     times = np.array([e.elapsed_time for e in wins])
@@ -238,6 +252,8 @@ def summarize(episodes: Sequence[Episode], optimal_time: float, optimal_effort: 
         "mean_time": float(np.mean(times)) if wins else None,
         "mean_effort": float(np.mean(efforts)) if wins else None,
         "solver_failures": int(sum(e.solver_failures for e in episodes)),
+        "compute_per_step": float(np.mean([e.compute_per_step for e in episodes]))
+        if episodes else 0.0,
     }
 
 
@@ -358,6 +374,13 @@ def _nominal_text(row: dict[str, Any]) -> str:
             if nominal.is_success else "fails")  # fmt: skip
 
 
+def _compute_text(row: dict[str, Any]) -> str:
+    """The mean wall time of one policy call over the row's perturbed episodes."""
+    times = [run["summary"]["compute_per_step"] for run in row["runs"]]
+    seconds = float(np.mean(times))
+    return f"{1e3 * seconds:.3g} ms" if seconds < 1.0 else f"{seconds:.2f} s"
+
+
 def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
     """One row per env x task x controller: IQM [95 % CI] over runs (n) of each score.
 
@@ -365,8 +388,9 @@ def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
     (its cells show the value alone, "(controller)").
     """
     lines = ["| env | task | controller | runs | success (perturbed starts), IQM [95 % CI] | "
-             "time / optimal | effort / optimal | nominal start | training budget |",
-             "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+             "time / optimal | effort / optimal | nominal start | compute / step | "
+             "training budget |",
+             "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for comparison in comparisons:
         env = comparison["env_id"].split("/")[-1]
         starts = len(comparison["seeds"])
@@ -384,7 +408,8 @@ def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
                            for v in (aggregate["time_ratio"], aggregate["effort_ratio"]))]
             lines.append(f"| {env} | {comparison['task']} | {row['label']} | {runs} | "
                          + " | ".join(cells)
-                         + f" | {_nominal_text(row)} | {budget_text(row)} |")  # fmt: skip
+                         + f" | {_nominal_text(row)} | {_compute_text(row)} | "
+                         f"{budget_text(row)} |")  # fmt: skip
     return "\n".join(lines)
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import gymnasium as gym
@@ -88,7 +89,9 @@ def test_random_policy_is_reported_as_failure(manipulator_comparison: dict) -> N
     assert aggregate["time_ratio"] == {"n": 0, "missing": 1, "iqm": None, "ci": None,
                                        "values": []}  # fmt: skip
     table = markdown_table([manipulator_comparison])
-    assert "| random | controller, 2 starts | 0 % | - | - | fails |  |" in table
+    assert "| random | controller, 2 starts | 0 % | - | - | fails | " in table
+    assert run["summary"]["compute_per_step"] > 0.0  # each policy call timed
+    assert re.search(r"\| fails \| [0-9.e-]+ ms \|  \|", table)
 
 
 def test_perturbed_starts_differ_from_nominal(manipulator_comparison: dict) -> None:
