@@ -120,7 +120,7 @@ def run_compare(args: argparse.Namespace) -> int:
     """Handler of ``compare``: runs each env x task, prints and writes the table; returns 0."""
     import sys
 
-    from baselines.compare import TASKS, TRAINED_DIR, compare, markdown_table, write_comparison
+    from baselines.compare import TASKS, TRAINED_DIR, collect_tables, compare, write_comparison
 
     if args.seeds < 1:
         raise SystemExit(f"compare: --seeds must be >= 1, got {args.seeds}")
@@ -130,7 +130,6 @@ def run_compare(args: argparse.Namespace) -> int:
     if not jobs:
         raise SystemExit(f"compare: {args.env_id} has no task {args.task!r}")
     trained_dir = TRAINED_DIR if args.trained is None else args.trained
-    comparisons = []
     for env_id, task in jobs:
         extra = []
         if args.mpc:
@@ -145,8 +144,7 @@ def run_compare(args: argparse.Namespace) -> int:
                              log=lambda line: print(line, file=sys.stderr, flush=True))
         for path in write_comparison(comparison, args.output, trained_dir):
             print(f"wrote {path}", file=sys.stderr)
-        comparisons.append(comparison)
-    table = markdown_table(comparisons)
+    table = collect_tables(args.output)
     (args.output / "compare.md").write_text(table + "\n")
     print(table)
     return 0

@@ -430,7 +430,9 @@ def comparison_record(comparison: dict[str, Any]) -> dict[str, Any]:
 
 def write_comparison(comparison: dict[str, Any], output: Path,
                      trained_dir: Path = TRAINED_DIR) -> list[Path]:  # fmt: skip
-    """Write ``compare_{env}_{task}.json``, its ``.png`` and ``seeds_{env}_{task}.png``.
+    """Write ``compare_{env}_{task}.{json,png,md}`` and ``seeds_{env}_{task}.png``.
+
+    The ``.md`` is the comparison's ``markdown_table`` (``collect_tables`` joins them).
 
     The training curves of ``seeds_*.png`` come from the runs' ``STEM_episodes.csv`` in
     ``trained_dir`` where present.
@@ -450,12 +452,27 @@ def write_comparison(comparison: dict[str, Any], output: Path,
     plot_comparison(comparison, png_path)
     seeds_path = output / f"seeds_{stem}.png"
     plot_seeds(comparison, seeds_path, trained_dir)
-    return [json_path, png_path, seeds_path]
+    table_path = output / f"compare_{stem}.md"
+    table_path.write_text(markdown_table([comparison]) + "\n")
+    return [json_path, png_path, seeds_path, table_path]
+
+
+def collect_tables(output: Path) -> str:
+    """One Markdown table of every ``compare_*.md`` in ``output`` (env x task, sorted).
+
+    A comparison rerun for one env x task so keeps the others' rows in ``compare.md``.
+    """
+    header: list[str] = []
+    rows: list[str] = []
+    for path in sorted(Path(output).glob("compare_*.md")):
+        lines = path.read_text().strip().splitlines()
+        header, rows = lines[:2], rows + lines[2:]
+    return "\n".join(header + rows)
 
 
 __all__ = [
     "CONTROLLER_FACTORIES", "OPTIMAL", "REFERENCE_NAMES", "SCORES", "TASKS", "TRAINED_DIR",
-    "Controller", "Episode", "aggregate_runs", "compare", "comparison_record",
+    "Controller", "Episode", "aggregate_runs", "collect_tables", "compare", "comparison_record",
     "evaluate_controller", "group_by_algorithm", "interval_text", "load_policy",
     "markdown_table", "optimal_controller", "play", "reference_controller", "reference_effort",
     "registered_controllers", "shipped_policies", "summarize", "write_comparison",

@@ -15,6 +15,7 @@ from baselines.compare import (
     OPTIMAL,
     Controller,
     Episode,
+    collect_tables,
     compare,
     group_by_algorithm,
     interval_text,
@@ -125,7 +126,9 @@ def test_summarize_counts_only_successes() -> None:
 
 
 def test_write_comparison(manipulator_comparison: dict, tmp_path: Path) -> None:
-    json_path, png_path, seeds_path = write_comparison(manipulator_comparison, tmp_path)
+    json_path, png_path, seeds_path, table_path = write_comparison(manipulator_comparison,
+                                                                   tmp_path)
+    assert collect_tables(tmp_path) == table_path.read_text().strip()
     record = json.loads(json_path.read_text())
     assert [row["label"] for row in record["controllers"]] == [OPTIMAL, "reference controls",
                                                                  "random"]  # fmt: skip
@@ -214,4 +217,4 @@ def test_compare_aggregates_the_seeds_of_an_algorithm(tmp_path: Path) -> None:
     steps, wins = episode_log(row["runs"][0]["config"], tmp_path)
     assert len(steps) == len(wins) == 2
     paths = write_comparison(comparison, tmp_path / "out", tmp_path)
-    assert all(path.stat().st_size > 10_000 for path in paths[1:])
+    assert all(path.stat().st_size > 10_000 for path in paths[1:3])  # the plots
