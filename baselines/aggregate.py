@@ -118,6 +118,10 @@ def performance_profiles(scores: Mapping[str, Sequence[float]], taus: np.ndarray
     return {label: {**profiles, **singles}[label] for label in matrices}, dict(intervals)
 
 
+CURVE_POINTS = 200
+"""Points of a run's compact training curve (``sampled_curve``, ``STEM_curve.csv``)."""
+
+
 def success_curve(steps: np.ndarray, success: np.ndarray, grid: np.ndarray,
                   window: int = 100) -> np.ndarray:  # fmt: skip
     """One run's success rate (moving mean over ``window`` episodes) at ``grid`` steps.
@@ -141,14 +145,29 @@ def success_curve(steps: np.ndarray, success: np.ndarray, grid: np.ndarray,
     return np.where(index >= 0, curve, np.nan)
 
 
+def sampled_curve(steps: np.ndarray, success: np.ndarray, num_points: int = CURVE_POINTS,
+                  window: int = 100) -> tuple[np.ndarray, np.ndarray]:
+    """One run's ``success_curve`` on ``num_points`` steps from its first to its last episode.
+
+    Returns:
+        (steps (P,), success rate (P,)): the compact curve ``STEM_curve.csv`` keeps.
+    """
+    steps = np.asarray(steps, dtype=float)
+    if len(steps) == 0:
+        return np.zeros(0), np.zeros(0)
+    grid = np.linspace(steps[0], steps[-1], num_points)
+    return grid, success_curve(steps, success, grid, window)
+
+
 def training_curves(runs: Mapping[str, Sequence[tuple[np.ndarray, np.ndarray]]],
                     num_points: int = 40, reps: int = BOOTSTRAP_REPS, seed: int = 0
                     ) -> dict[str, dict[str, Any]]:  # fmt: skip
     """IQM and 95 % CI over runs of the training success rate, per label.
 
     Args:
-        runs: label -> one (steps (E,), success (E,)) episode log per run.
-        num_points: grid points from the first to the shortest run's last step.
+        runs: label -> one curve (steps (P,), success rate (P,)) per run (``sampled_curve``,
+            ascending steps), interpolated linearly onto the common grid.
+        num_points: grid points from the latest first step to the shortest run's last step.
         reps: bootstrap replications. seed: the resampling's seed.
 
     Returns:
@@ -158,12 +177,12 @@ def training_curves(runs: Mapping[str, Sequence[tuple[np.ndarray, np.ndarray]]],
 
     curves: dict[str, dict[str, Any]] = {}
     for label, logs in runs.items():
-        logs = [(np.asarray(s, float), np.asarray(k, float)) for s, k in logs if len(s)]
+        logs = [(np.asarray(s, float), np.asarray(r, float)) for s, r in logs if len(s)]
         if not logs:
             continue
         end = min(float(steps[-1]) for steps, _ in logs)
         grid = np.linspace(max(float(steps[0]) for steps, _ in logs), end, num_points)
-        matrix = np.stack([success_curve(s, k, grid) for s, k in logs])[:, None, :]  # (R, 1, G)
+        matrix = np.stack([np.interp(grid, s, r) for s, r in logs])[:, None, :]  # (R, 1, G)
 
         def per_point(scores: np.ndarray) -> np.ndarray:
             from rliable import metrics
@@ -183,6 +202,6 @@ def training_curves(runs: Mapping[str, Sequence[tuple[np.ndarray, np.ndarray]]],
 
 
 __all__ = [
-    "BOOTSTRAP_REPS", "CONFIDENCE", "iqm_interval", "performance_profiles", "success_curve",
-    "training_curves",
+    "BOOTSTRAP_REPS", "CONFIDENCE", "CURVE_POINTS", "iqm_interval", "performance_profiles",
+    "sampled_curve", "success_curve", "training_curves",
 ]

@@ -4,10 +4,10 @@ Three panels per env x task, drawn with ``rliable.plot_utils``: the performance 
 success rate (fraction of runs whose success rate over the perturbed starts exceeds tau), the
 profile of the optimality score (optimum / the run's mean time or effort over its successes,
 1 = optimal; 0 for a run without success), and the training curves: the IQM over seeds of the
-training success rate (moving mean over 100 episodes, from each run's ``STEM_episodes.csv``)
-with its 95 % stratified-bootstrap band. Bands need two runs or more; one run is drawn as a
-line labelled n=1, and a row without episode logs is left out of the curves (named in the
-panel).
+training success rate (moving mean over 100 episodes, from each run's ``STEM_curve.csv`` or
+``STEM_episodes.csv``, ``run_curve``) with its 95 % stratified-bootstrap band. Bands need two
+runs or more; one run is drawn as a line labelled n=1, and a row without a curve is left out
+(named in the panel).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after selecting the non-interactive backend)
 import numpy as np  # noqa: E402
 
-from baselines.aggregate import performance_profiles, training_curves  # noqa: E402
+from baselines.aggregate import performance_profiles, sampled_curve, training_curves  # noqa: E402
 from baselines.compare import OPTIMAL  # noqa: E402
 
 TAUS = np.linspace(0.0, 1.0, 101)
@@ -35,17 +35,26 @@ def optimality_score(run: dict[str, Any], task: str) -> float:
     return 0.0 if ratio is None else 1.0 / ratio
 
 
-def episode_log(config: dict[str, Any], trained_dir: Path) -> tuple[np.ndarray, np.ndarray] | None:
-    """(steps (E,), success (E,)) of a run's ``STEM_episodes.csv`` in ``trained_dir``, or None."""
-    from baselines.train import run_name
+def run_curve(config: dict[str, Any], trained_dir: Path) -> tuple[np.ndarray, np.ndarray] | None:
+    """(steps (P,), success rate (P,)) of a run in ``trained_dir``, or None.
+
+    From its ``STEM_curve.csv`` (shipped), else from its ``STEM_episodes.csv`` (a fresh
+    training folder) through ``sampled_curve``.
+    """
+    from baselines.train import read_episodes, run_name
 
     stem = run_name(config["env_id"], config["task"], config["algo"], int(config["seed"]))
-    path = Path(trained_dir) / f"{stem}_episodes.csv"
-    if not path.exists():
-        return None
-    with path.open() as handle:
-        rows = [(float(r["timesteps"]), r["is_success"] == "True") for r in csv.DictReader(handle)]
-    return np.array([r[0] for r in rows]), np.array([r[1] for r in rows], dtype=float)
+    curve, episodes = (Path(trained_dir) / f"{stem}_{kind}.csv" for kind in ("curve", "episodes"))
+    if curve.exists():
+        with curve.open() as handle:
+            rows = [(float(r["timesteps"]), float(r["success_rate"]))
+                    for r in csv.DictReader(handle)]
+        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+    if episodes.exists():
+        rows = read_episodes(episodes)
+        return sampled_curve(np.array([r[0] for r in rows], dtype=float),
+                             np.array([r[3] for r in rows], dtype=float))
+    return None
 
 
 def _colours(rows: list[dict[str, Any]]) -> dict[str, Any]:
@@ -75,7 +84,7 @@ def _curve_panel(ax: Any, comparison: dict[str, Any], trained_dir: Path,
     for row in comparison["controllers"]:
         if not row["trained"]:
             continue
-        found = [episode_log(run["config"], trained_dir) for run in row["runs"]]
+        found = [run_curve(run["config"], trained_dir) for run in row["runs"]]
         logs[row["label"]] = [log for log in found if log is not None]
         if not logs[row["label"]]:
             missing.append(row["label"])
@@ -90,7 +99,7 @@ def _curve_panel(ax: Any, comparison: dict[str, Any], trained_dir: Path,
                                                               else ")"))  # fmt: skip
     if ax.lines:
         ax.legend(fontsize=7, loc="lower right")
-    note = f"no episode logs: {', '.join(missing)}" if missing else ""
+    note = f"no training curves: {', '.join(missing)}" if missing else ""
     ax.set_title("training curves, 95 % CI over seeds" + (f"\n({note})" if note else ""),
                  fontsize=9)  # fmt: skip
     ax.set_ylim(-0.05, 1.05)
@@ -118,4 +127,4 @@ def plot_seeds(comparison: dict[str, Any], path: Path, trained_dir: Path) -> Non
     plt.close(fig)
 
 
-__all__ = ["TAUS", "episode_log", "optimality_score", "plot_seeds"]
+__all__ = ["TAUS", "optimality_score", "plot_seeds", "run_curve"]

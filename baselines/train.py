@@ -12,7 +12,10 @@ checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched 
 - ``STEM.json``: env id, task, algorithm, seed, the exact SB3 and env arguments, budget,
   package versions, git commit, wall time, training and evaluation scores;
 - ``STEM_episodes.csv``: one row per finished training episode (timesteps, return, length,
-  success, elapsed time [s], effort [N^2 m^2 s]);
+  success, elapsed time [s], effort [N^2 m^2 s]); large, kept local;
+- ``STEM_curve.csv``: the compact training curve shipped with a policy (``write_curve``: the
+  success rate over the last 100 episodes at 200 steps), from which the seed plots draw their
+  bands;
 - ``STEM.png``: episode return and success rate vs environment steps;
 - ``tensorboard/STEM_1/``: SB3's TensorBoard logs (``tensorboard --logdir OUTPUT/tensorboard``);
 
@@ -182,6 +185,7 @@ def train(
 
     evaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed=seed + 10_000)
     write_episodes(log.rows, output / f"{stem}_episodes.csv")
+    write_curve(log.rows, output / f"{stem}_curve.csv")
     recent = log.rows[-100:]
     config = {
         "env_id": env_id, "task": task, "algo": algo, "seed": seed,
@@ -252,6 +256,30 @@ def write_episodes(rows: list[tuple[Any, ...]], path: Path) -> None:
         writer = csv.writer(handle)
         writer.writerow(EPISODE_COLUMNS)
         writer.writerows(rows)
+
+
+def write_curve(rows: list[tuple[Any, ...]], path: Path) -> None:
+    """Write the compact training curve (``baselines.aggregate.sampled_curve``) as CSV.
+
+    Columns: timesteps, success_rate (moving mean over the last 100 episodes).
+    """
+    from baselines.aggregate import sampled_curve
+
+    steps, rates = sampled_curve(np.array([r[0] for r in rows], dtype=float),
+                                 np.array([r[3] for r in rows], dtype=float))
+    with path.open("w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(("timesteps", "success_rate"))
+        writer.writerows((int(step), f"{rate:.4f}") for step, rate in zip(steps, rates,
+                                                                           strict=True))
+
+
+def read_episodes(path: Path) -> list[tuple[Any, ...]]:
+    """The rows of a ``STEM_episodes.csv`` (``EPISODE_COLUMNS``, typed as written)."""
+    with Path(path).open() as handle:
+        return [(int(float(r["timesteps"])), float(r["return"]), int(float(r["length"])),
+                 r["is_success"] == "True", float(r["elapsed_time"]), float(r["effort"]))
+                for r in csv.DictReader(handle)]
 
 
 def plot_training(rows: list[tuple[Any, ...]], path: Path, title: str = "",

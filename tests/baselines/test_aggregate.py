@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from baselines.aggregate import iqm_interval, performance_profiles, success_curve, training_curves
+from baselines.aggregate import (
+    iqm_interval,
+    performance_profiles,
+    sampled_curve,
+    success_curve,
+    training_curves,
+)
 
 pytest.importorskip("rliable", reason="rliable is in the rl extra")
 
@@ -36,8 +42,15 @@ def test_success_curve_is_the_moving_mean_of_finished_episodes() -> None:
     assert curve[1:] == pytest.approx([0.0, 0.5, 1.0])
 
 
+def test_sampled_curve_spans_the_run() -> None:
+    steps, rates = sampled_curve(np.arange(1.0, 401.0), (np.arange(400) >= 200).astype(float),
+                                 num_points=5)
+    assert steps.tolist() == [1.0, 100.75, 200.5, 300.25, 400.0]
+    assert rates.tolist() == pytest.approx([0.0, 0.0, 0.0, 1.0, 1.0])  # moving mean of 100
+
+
 def test_training_curves_band_needs_two_runs() -> None:
-    run = (np.arange(1.0, 201.0), (np.arange(200) > 100).astype(float))
+    run = sampled_curve(np.arange(1.0, 201.0), (np.arange(200) > 100).astype(float))
     curves = training_curves({"one": [run], "two": [run, run]}, num_points=5, reps=100)
     assert curves["one"]["ci"] is None and curves["one"]["n"] == 1
     assert curves["two"]["ci"].shape == (2, 5)

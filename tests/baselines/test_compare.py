@@ -10,6 +10,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
+from baselines.aggregate import CURVE_POINTS
 from baselines.compare import (
     CONTROLLER_FACTORIES,
     OPTIMAL,
@@ -195,7 +196,7 @@ def test_compare_aggregates_the_seeds_of_an_algorithm(tmp_path: Path) -> None:
     """Two tiny PPO runs (seeds 1, 2) form one row: IQM, a CI, n=2, curves from their CSVs."""
     import torch
 
-    from baselines.seed_plots import episode_log
+    from baselines.seed_plots import run_curve
     from baselines.train import train
 
     torch.set_num_threads(1)
@@ -214,7 +215,7 @@ def test_compare_aggregates_the_seeds_of_an_algorithm(tmp_path: Path) -> None:
     table = markdown_table([comparison])
     assert "| PPO | 2 seeds x 2 starts | " in table and "(n=2)" in table
     assert "1.2e+03 steps, 2 envs, seeds 1-2 |" in table  # 1152 steps taken
-    steps, wins = episode_log(row["runs"][0]["config"], tmp_path)
-    assert len(steps) == len(wins) == 2
+    steps, rates = run_curve(row["runs"][0]["config"], tmp_path)
+    assert len(steps) == len(rates) == CURVE_POINTS and np.all(np.diff(steps) >= 0)
     paths = write_comparison(comparison, tmp_path / "out", tmp_path)
     assert all(path.stat().st_size > 10_000 for path in paths[1:3])  # the plots
