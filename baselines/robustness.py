@@ -15,7 +15,8 @@ Reported per controller and condition: the success rate (mean over a trained alg
 with the per-seed rates) and, over the successes, the time and effort ratios to the reference.
 ``python -m baselines.robustness ENV_ID|all [--task T] [--seeds N] [--mpc]`` writes
 ``robustness_ENV_TASK.json``, ``.png`` (success against the perturbation scale, one curve per
-controller; success under each mismatch) and ``robustness.md``.
+controller; success under each mismatch) and ``robustness.md`` (the table of every
+``robustness_*.json`` in the output folder).
 """
 
 from __future__ import annotations
@@ -224,7 +225,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             if args.env_id in ("all", key[0]) and args.task in (None, key[1])]
     if not jobs:
         parser.error(f"{args.env_id} has no task {args.task!r}")
-    studies = []
     for env_id, task in jobs:
         study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
                            log=lambda line: print(line, file=sys.stderr, flush=True),
@@ -233,7 +233,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         args.output.mkdir(parents=True, exist_ok=True)
         (args.output / f"{stem}.json").write_text(json.dumps(study, indent=1))
         plot_robustness(study, args.output / f"{stem}.png")
-        studies.append(study)
+    # every study in the folder, so that rerunning one env x task keeps the others' rows
+    studies = [json.loads(path.read_text())
+               for path in sorted(args.output.glob("robustness_*.json"))]
     table = markdown_table(studies)
     (args.output / "robustness.md").write_text(table + "\n")
     print(table)

@@ -46,3 +46,8 @@ def test_cli_writes_json_plot_and_table(tmp_path: Path) -> None:
     assert study["task"] == "effort" and study["seeds"] == 1
     assert (out / "robustness_DiffDriveRobot-v0_effort.png").stat().st_size > 0
     assert "| optimal (open loop) | 1 |" in (out / "robustness.md").read_text()
+    # a rerun of another env x task keeps this one's rows in robustness.md
+    assert main([ROBOT, "--task", "time", "--seeds", "1", "--scales", "0.01", "--no-mismatch",
+                 "--trained", str(tmp_path), "--output", str(out)]) == 0
+    table = (out / "robustness.md").read_text()
+    assert "DiffDriveRobot-v0 effort" in table and "DiffDriveRobot-v0 time" in table
