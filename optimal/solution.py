@@ -70,12 +70,16 @@ def read_modes(transcription: Transcription, values: Callable[[Any], Any]) -> Mo
     scale = problem.velocity_scale
     engaged = sliding = None
     if "brake_velocity" in outputs:
-        velocity = np.atleast_2d(numeric(values(outputs["brake_velocity"])))
+        velocity = _rows(outputs["brake_velocity"], values)
         engaged = np.abs(velocity) <= BRAKE_VELOCITY_TOLERANCE * scale
     if "slip_speed" in outputs:
-        speed = np.atleast_2d(numeric(values(outputs["slip_speed"])))
-        sliding = speed > SLIP_TOLERANCE * scale
+        sliding = _rows(outputs["slip_speed"], values) > SLIP_TOLERANCE * scale
     return ModePattern(engaged=engaged, sliding=sliding)
+
+
+def _rows(expression: Any, values: Callable[[Any], Any]) -> np.ndarray:
+    """The value of a (rows, N) expression with its shape (CasADi drops unit dimensions)."""
+    return numeric(values(expression)).reshape(expression.shape)
 
 
 def values_at(problem: OptimalControlProblem, modes: ModePattern | None,
