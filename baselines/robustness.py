@@ -16,7 +16,9 @@ with the per-seed rates) and, over the successes, the time and effort ratios to 
 ``python -m baselines.robustness ENV_ID|all [--task T] [--seeds N] [--mpc]`` writes
 ``robustness_ENV_TASK.json``, ``.png`` (success against the perturbation scale, one curve per
 controller; success under each mismatch) and ``robustness.md`` (the table of every
-``robustness_*.json`` in the output folder).
+``robustness_*.json`` in the output folder). ``--controllers LABEL ... [--scales ...]
+[--no-mismatch]`` plays only those and merges their results into the study in the folder
+(``merge_studies``), so a slow controller's conditions can be run one at a time.
 """
 
 from __future__ import annotations
@@ -100,10 +102,12 @@ def controllers_for(env_id: str, task: str, mpc: bool = False,
 def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                scales: Sequence[float] = SCALES, trained_dir: Path = TRAINED_DIR,
                log: Callable[[str], None] | None = None,
-               mismatches: bool = True) -> dict[str, Any]:
+               mismatches: bool = True, only: Sequence[str] | None = None) -> dict[str, Any]:
     """Play every controller under every condition (see the module docstring).
 
-    ``mismatches=False`` plays the perturbation scales only.
+    ``mismatches=False`` plays the perturbation scales only; ``only`` names the controllers
+    to play (labels, e.g. "PPO"; None: all), for a study completed piece by piece
+    (``merge_studies``).
 
     Returns:
         {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort", "seeds",
@@ -123,6 +127,8 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
     factories = dict(MISMATCHES[env_id])
     rows = []
     for label, runs in controllers_for(env_id, task, mpc, trained_dir):
+        if only is not None and label not in only:
+            continue
         results = []
         for condition in conditions:
             summaries = []
@@ -149,6 +155,31 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
             "seeds": num_seeds, "conditions": conditions, "controllers": rows}
 
 
+def merge_studies(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
+    """``old`` with the (controller, condition) results of ``new`` added or replaced.
+
+    Both must be of the same env, task and number of starts. Conditions keep their order
+    (scales ascending, then the mismatches); a controller without a result for some condition
+    shows none there.
+    """
+    for key in ("env_id", "task", "seeds"):
+        if old[key] != new[key]:
+            raise ValueError(f"cannot merge studies of different {key}: {old[key]} and "
+                             f"{new[key]}")
+    conditions = {c["label"]: c for c in old["conditions"] + new["conditions"]}
+    mismatch_order = [label for label, _ in MISMATCHES[new["env_id"]]]
+    ordered = sorted(conditions.values(), key=lambda c: (
+        c["mismatch"] is not None,
+        c["scale"] if c["mismatch"] is None else mismatch_order.index(c["mismatch"])))
+    rows = {row["label"]: row for row in old["controllers"]}
+    for row in new["controllers"]:
+        kept = rows.get(row["label"], {"results": []})["results"]
+        by_condition = {r["condition"]: r for r in kept + row["results"]}
+        rows[row["label"]] = {**row, "results": [by_condition[c["label"]] for c in ordered
+                                                 if c["label"] in by_condition]}
+    return {**new, "conditions": ordered, "controllers": list(rows.values())}
+
+
 def markdown_table(studies: Sequence[dict[str, Any]]) -> str:
     """One row per env x task x controller; success (ratio over the successes) per condition."""
     lines: list[str] = []
@@ -161,9 +192,13 @@ def markdown_table(studies: Sequence[dict[str, Any]]) -> str:
                   "|---|---|" + "---|" * len(labels)]
         for row in study["controllers"]:
             cells = []
-            for result in row["results"]:
-                ratio = result[f"{ratio_name}_ratio"]
-                cells.append(f"{result['success_rate']:.0%}"
+            results = {result["condition"]: result for result in row["results"]}
+            for label in labels:
+                if label not in results:
+                    cells.append("-")
+                    continue
+                ratio = results[label][f"{ratio_name}_ratio"]
+                cells.append(f"{results[label]['success_rate']:.0%}"
                              + ("" if ratio is None else f" ({ratio:.2f})"))
             lines.append(f"| {row['label']} | {row['runs']} | " + " | ".join(cells) + " |")
     return "\n".join(lines).strip()
@@ -176,16 +211,17 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    scaled = [i for i, c in enumerate(study["conditions"]) if c["mismatch"] is None]
-    mismatched = [i for i, c in enumerate(study["conditions"]) if c["mismatch"] is not None]
+    scaled = [c for c in study["conditions"] if c["mismatch"] is None]
+    mismatched = [c for c in study["conditions"] if c["mismatch"] is not None]
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
-    scales = [study["conditions"][i]["scale"] for i in scaled]
     width = 0.8 / max(len(study["controllers"]), 1)
     for k, row in enumerate(study["controllers"]):
-        left.plot(scales, [100 * row["results"][i]["success_rate"] for i in scaled], "o-",
+        success = {r["condition"]: 100 * r["success_rate"] for r in row["results"]}
+        played = [c for c in scaled if c["label"] in success]
+        left.plot([c["scale"] for c in played], [success[c["label"]] for c in played], "o-",
                   label=f"{row['label']} ({row['runs']} run{'s' * (row['runs'] > 1)})")
         right.bar(np.arange(len(mismatched)) + k * width,
-                  [100 * row["results"][i]["success_rate"] for i in mismatched], width,
+                  [success.get(c["label"], np.nan) for c in mismatched], width,
                   label=row["label"])
     left.set_xscale("log")
     left.set_xlabel("start perturbation scale [rad, rad/s, m, m/s]")
@@ -194,7 +230,7 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
     left.set_title(f"{study['env_id'].split('/')[-1]} {study['task']}: perturbed starts")
     left.legend(fontsize=8)
     right.set_xticks(np.arange(len(mismatched)) + width * (len(study["controllers"]) - 1) / 2)
-    right.set_xticklabels([study["conditions"][i]["label"] for i in mismatched], fontsize=8)
+    right.set_xticklabels([c["label"] for c in mismatched], fontsize=8)
     right.set_ylabel("success [%]")
     right.set_ylim(0, 103)
     right.set_title(f"model mismatch (scale {DEFAULT_SCALE:g})")
@@ -216,6 +252,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--mpc", action="store_true", help="include the MPC (needs CasADi)")
     parser.add_argument("--mismatch", action=argparse.BooleanOptionalAction, default=True,
                         help="also play the model mismatches (default: yes)")
+    parser.add_argument("--controllers", nargs="+", default=None, metavar="LABEL",
+                        help="play only these controllers (labels as in the table) and merge "
+                        "their results into the study already in --output")
     parser.add_argument("--trained", type=Path, default=TRAINED_DIR)
     parser.add_argument("--output", type=Path, default=Path("results/robustness"))
     args = parser.parse_args(argv)
@@ -228,10 +267,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     for env_id, task in jobs:
         study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
                            log=lambda line: print(line, file=sys.stderr, flush=True),
-                           mismatches=args.mismatch)
+                           mismatches=args.mismatch, only=args.controllers)
         stem = f"robustness_{env_id.split('/')[-1]}_{task}"
         args.output.mkdir(parents=True, exist_ok=True)
-        (args.output / f"{stem}.json").write_text(json.dumps(study, indent=1))
+        path = args.output / f"{stem}.json"
+        if args.controllers is not None and path.exists():
+            study = merge_studies(json.loads(path.read_text()), study)
+        path.write_text(json.dumps(study, indent=1))
         plot_robustness(study, args.output / f"{stem}.png")
     # every study in the folder, so that rerunning one env x task keeps the others' rows
     studies = [json.loads(path.read_text())
@@ -243,7 +285,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 __all__ = ["DEFAULT_SCALE", "MISMATCHES", "SCALES", "controllers_for", "main", "markdown_table",
-           "plot_robustness", "robustness"]
+           "merge_studies", "plot_robustness", "robustness"]
 
 
 if __name__ == "__main__":

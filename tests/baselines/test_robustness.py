@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from baselines.robustness import MISMATCHES, main, robustness  # noqa: E402
+from baselines.robustness import MISMATCHES, main, merge_studies, robustness  # noqa: E402
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters  # noqa: E402
 
 ROBOT = "mdi_envs/DiffDriveRobot-v0"
@@ -51,3 +51,19 @@ def test_cli_writes_json_plot_and_table(tmp_path: Path) -> None:
                  "--trained", str(tmp_path), "--output", str(out)]) == 0
     table = (out / "robustness.md").read_text()
     assert "DiffDriveRobot-v0 effort" in table and "DiffDriveRobot-v0 time" in table
+
+
+def test_a_controller_rerun_merges_into_the_study(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    common = [ROBOT, "--task", "effort", "--seeds", "1", "--no-mismatch", "--trained",
+              str(tmp_path), "--output", str(out)]
+    assert main([*common, "--scales", "0.01"]) == 0
+    assert main([*common, "--scales", "0.3", "--controllers", "optimal (open loop)"]) == 0
+    study = json.loads((out / "robustness_DiffDriveRobot-v0_effort.json").read_text())
+    assert [c["label"] for c in study["conditions"]] == ["perturbation 0.01",
+                                                         "perturbation 0.3"]
+    (row,) = study["controllers"]
+    assert [r["condition"] for r in row["results"]] == ["perturbation 0.01", "perturbation 0.3"]
+    assert row["results"][1]["success_rate"] == 0.0  # the open loop at 0.3 (as above)
+    with pytest.raises(ValueError, match="seeds"):
+        merge_studies(study, {**study, "seeds": 2})
