@@ -67,7 +67,8 @@ friction (``Transcription.set_guess``). The brake impulses are not carried: warm
 them, the nominal N = 40 manipulator run left its plan at step 24 and took 7 % longer."""
 
 NLP_CACHE_SIZE = 400
-"""Fixed-pattern NLPs a controller keeps (least recently used dropped; about 1-3 MB each).
+"""Fixed-pattern NLPs a controller keeps (least recently used dropped). Each takes about 11 MB
+at 120 intervals (the 20-start manipulator evaluation's process grew to 4.9 GB).
 Building one costs 0.5-0.8 s at 120 intervals and its first solve another 0.2 s (CasADi's
 expand); a warm-started re-solve of a kept one about 0.1 s. Episodes from nearby starts visit
 the same (intervals, pattern) keys, so from the second episode on most steps reuse an NLP."""
