@@ -213,7 +213,7 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
 
     scaled = [c for c in study["conditions"] if c["mismatch"] is None]
     mismatched = [c for c in study["conditions"] if c["mismatch"] is not None]
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 5))
     width = 0.8 / max(len(study["controllers"]), 1)
     for k, row in enumerate(study["controllers"]):
         success = {r["condition"]: 100 * r["success_rate"] for r in row["results"]}
@@ -228,7 +228,7 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
     left.set_ylabel("success [%]")
     left.set_ylim(-3, 103)
     left.set_title(f"{study['env_id'].split('/')[-1]} {study['task']}: perturbed starts")
-    left.legend(fontsize=8)
+    left.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2)
     right.set_xticks(np.arange(len(mismatched)) + width * (len(study["controllers"]) - 1) / 2)
     right.set_xticklabels([c["label"] for c in mismatched], fontsize=8)
     right.set_ylabel("success [%]")
