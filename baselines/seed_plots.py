@@ -47,9 +47,9 @@ def run_curve(config: dict[str, Any], trained_dir: Path) -> tuple[np.ndarray, np
     curve, episodes = (Path(trained_dir) / f"{stem}_{kind}.csv" for kind in ("curve", "episodes"))
     if curve.exists():
         with curve.open() as handle:
-            rows = [(float(r["timesteps"]), float(r["success_rate"]))
-                    for r in csv.DictReader(handle)]
-        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+            points = [(float(r["timesteps"]), float(r["success_rate"]))
+                      for r in csv.DictReader(handle)]
+        return np.array([p[0] for p in points]), np.array([p[1] for p in points])
     if episodes.exists():
         rows = read_episodes(episodes)
         return sampled_curve(np.array([r[0] for r in rows], dtype=float),

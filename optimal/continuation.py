@@ -198,11 +198,11 @@ def set_solver(transcription: Transcription, schedule: Schedule,
     if transcription.solver_settings == settings:
         return
     transcription.solver_settings = settings
-    transcription.opti.solver("ipopt", {"expand": True, "print_time": False},
-                {"print_level": 0, "max_iter": schedule.max_iterations,
-                 "tol": schedule.tolerance, "acceptable_tol": 1e-7,
-                 "mu_strategy": schedule.mu_strategy, "bound_relax_factor": bound_relaxation,
-                 "sb": "yes"})
+    transcription.opti.solver(
+        "ipopt", {"expand": True, "print_time": False},
+        {"print_level": 0, "max_iter": schedule.max_iterations, "tol": schedule.tolerance,
+         "acceptable_tol": 1e-7, "mu_strategy": schedule.mu_strategy,
+         "bound_relax_factor": bound_relaxation, "sb": "yes"})
 
 
 def _fix_active_sets(transcription: Transcription, values: Callable[[Any], Any]) -> None:
