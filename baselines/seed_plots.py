@@ -22,7 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after selecting the non-interactive backend)
 import numpy as np  # noqa: E402
 
-from baselines.aggregate import performance_profiles, sampled_curve, training_curves  # noqa: E402
+from baselines.aggregate import performance_profiles, training_curves  # noqa: E402
 from baselines.compare import OPTIMAL  # noqa: E402
 
 TAUS = np.linspace(0.0, 1.0, 101)
@@ -39,9 +39,9 @@ def run_curve(config: dict[str, Any], trained_dir: Path) -> tuple[np.ndarray, np
     """(steps (P,), success rate (P,)) of a run in ``trained_dir``, or None.
 
     From its ``STEM_curve.csv`` (shipped), else from its ``STEM_episodes.csv`` (a fresh
-    training folder) through ``sampled_curve``.
+    training folder) through ``baselines.train.training_curve``.
     """
-    from baselines.train import read_episodes, run_name
+    from baselines.train import read_episodes, run_name, training_curve
 
     stem = run_name(config["env_id"], config["task"], config["algo"], int(config["seed"]))
     curve, episodes = (Path(trained_dir) / f"{stem}_{kind}.csv" for kind in ("curve", "episodes"))
@@ -51,9 +51,7 @@ def run_curve(config: dict[str, Any], trained_dir: Path) -> tuple[np.ndarray, np
                       for r in csv.DictReader(handle)]
         return np.array([p[0] for p in points]), np.array([p[1] for p in points])
     if episodes.exists():
-        rows = read_episodes(episodes)
-        return sampled_curve(np.array([r[0] for r in rows], dtype=float),
-                             np.array([r[3] for r in rows], dtype=float))
+        return training_curve(read_episodes(episodes))
     return None
 
 

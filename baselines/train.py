@@ -258,15 +258,20 @@ def write_episodes(rows: list[tuple[Any, ...]], path: Path) -> None:
         writer.writerows(rows)
 
 
+def training_curve(rows: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray]:
+    """(steps (P,), success rate (P,)) of an episode log (``baselines.aggregate.sampled_curve``)."""
+    from baselines.aggregate import sampled_curve
+
+    return sampled_curve(np.array([r[0] for r in rows], dtype=float),
+                         np.array([r[3] for r in rows], dtype=float))
+
+
 def write_curve(rows: list[tuple[Any, ...]], path: Path) -> None:
-    """Write the compact training curve (``baselines.aggregate.sampled_curve``) as CSV.
+    """Write the compact training curve (``training_curve``) as CSV.
 
     Columns: timesteps, success_rate (moving mean over the last 100 episodes).
     """
-    from baselines.aggregate import sampled_curve
-
-    steps, rates = sampled_curve(np.array([r[0] for r in rows], dtype=float),
-                                 np.array([r[3] for r in rows], dtype=float))
+    steps, rates = training_curve(rows)
     with path.open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(("timesteps", "success_rate"))
@@ -339,6 +344,6 @@ def git_commit() -> str | None:
 
 
 __all__ = [
-    "EpisodeLog", "algorithm_class", "check_single_env", "evaluate", "plot_training", "run_name",
-    "train",
+    "EpisodeLog", "algorithm_class", "check_single_env", "evaluate", "plot_training",
+    "read_episodes", "run_name", "train", "training_curve", "write_curve", "write_episodes",
 ]

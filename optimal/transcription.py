@@ -180,7 +180,6 @@ class Transcription:
     _start: tuple[Any, Any] | None = field(init=False, default=None)
     _slack_guesses: list[tuple[Any, Callable[[], Any]]] = field(init=False, default_factory=list)
     _raw: dict[int, tuple[Any, float]] = field(init=False, default_factory=dict)
-    _cone_slack: Any = field(init=False, default=None)
     _contact: Any = field(init=False, default=None)
 
     def __post_init__(self) -> None:
@@ -284,7 +283,6 @@ class Transcription:
                                    s_vel * s_imp**2))
             self.outputs.update(normal_impulse=contact.normal, tangent_impulse=contact.tangent,
                                 slip_speed=contact.slip_speed, slip_velocity=contact.slip)
-            self._cone_slack = contact.cone_slack
             self._contact = contact
             self._slack_guesses += contact.guesses
 
@@ -318,7 +316,7 @@ class Transcription:
         sliding fixes the cone slack to 0 and keeps mu P_N xi_T + lam P_T = 0.
         """
         contact_slip = np.asarray(values(self.outputs["slip_speed"]), dtype=float)
-        cone = np.asarray(values(self._cone_slack), dtype=float)
+        cone = np.asarray(values(self._contact.cone_slack), dtype=float)
         pr = self.problem
         sliding = contact_slip / pr.velocity_scale > cone / pr.impulse_scale**2
         return Transcription(pr, modes=ModePattern(sliding=np.atleast_2d(sliding)))
@@ -371,12 +369,13 @@ class Transcription:
         for variable, guess in self._slack_guesses:
             self._set_initial(variable, self.opti.value(guess(), self.opti.initial()))
         given = {key: np.asarray(value, dtype=float).T for key, value in (impulses or {}).items()}
-        if self._contact is not None and "tangent_impulse" in given:
-            self._set_initial(self._contact.tangent, given["tangent_impulse"])
-            self._set_initial(self._contact.slip_speed, given.get(
-                "slip_speed", np.zeros(self._contact.slip_speed.shape)))
-            self._set_initial(self._cone_slack, self.opti.value(self._contact.cones,
-                                                                self.opti.initial()))
+        contact = self._contact
+        if contact is not None and "tangent_impulse" in given:
+            self._set_initial(contact.tangent, given["tangent_impulse"])
+            self._set_initial(contact.slip_speed,
+                              given.get("slip_speed", np.zeros(contact.slip_speed.shape)))
+            self._set_initial(contact.cone_slack,
+                              self.opti.value(contact.cones, self.opti.initial()))
 
     def variable(self, shape: tuple[int, int], scale: float, nonnegative: bool = False) -> Any:
         """A new NLP variable in units of ``scale``: returns scale * raw (the physical value)."""
