@@ -8,8 +8,9 @@ one interval -- and applies the first interval's torque and brake command. Each 
 once per (intervals, pattern, goal relaxed) with the start as a parameter
 (``Transcription(parametric_start=True)``) and kept (``NLP_CACHE_SIZE``): building costs more
 than a warm-started solve, and episodes from nearby starts revisit the same keys. Where the
-fixed-pattern solve fails, the fallbacks are, in order: the neighbouring patterns (switches
-shifted by one interval, phases merged or split), the goal relaxed to ``GOAL_TOLERANCE_FRACTION``
+fixed-pattern solve fails, the fallbacks are, in order: the neighbouring patterns that differ
+within the next ``NEIGHBOUR_WINDOW`` intervals (switches shifted by one interval, phases merged
+or split), the goal relaxed to ``GOAL_TOLERANCE_FRACTION``
 of the success box, the pattern freed (the reference's continuation schedule from the fixed
 solve's last iterate, then re-solved with the modes it found), and last the previous plan's
 next control open loop (``MPCStep.fallback``).
@@ -72,6 +73,11 @@ at 120 intervals (the 20-start manipulator evaluation's process grew to 4.9 GB).
 Building one costs 0.5-0.8 s at 120 intervals and its first solve another 0.2 s (CasADi's
 expand); a warm-started re-solve of a kept one about 0.1 s. Episodes from nearby starts visit
 the same (intervals, pattern) keys, so from the second episode on most steps reuse an NLP."""
+
+NEIGHBOUR_WINDOW = 3
+"""The neighbouring-pattern fallback tries only the moves that change one of the next this-many
+intervals: a measured state off the plan puts the imminent mode in doubt, not a switch seconds
+ahead. All neighbours of a robot plan (4 contacts) were 20-27 new NLPs, 30-50 s per fallback."""
 
 MAX_REPLAN_GROWTH = 1.5
 """A time-optimal re-plan longer than this times the previous remaining time (plus one step)
@@ -309,7 +315,7 @@ class ShrinkingHorizonMPC:
             return solve, _plan_of(solve, transcription), ""
         if guess.num_intervals > 1:
             candidates = [self._fixed(pattern, False, q, u, initial)
-                          for _, pattern in guess.modes.neighbours(max_shift=1)]
+                          for pattern in _imminent_neighbours(guess.modes)]
             accepted = [pair for pair in candidates if self._acceptable(pair[0], guess)]
             if accepted:
                 best = min(accepted, key=lambda pair: pair[0].cost)
@@ -353,6 +359,16 @@ class ShrinkingHorizonMPC:
         return GOAL_TOLERANCE_FRACTION * q_tol, GOAL_TOLERANCE_FRACTION * u_tol
 
 
+def _imminent_neighbours(modes: ModePattern) -> list[ModePattern]:
+    """``modes.neighbours(max_shift=1)`` that differ from ``modes`` within ``NEIGHBOUR_WINDOW``."""
+    window = slice(0, NEIGHBOUR_WINDOW)
+    return [pattern for _, pattern in modes.neighbours(max_shift=1)
+            if any(new is not None and old is not None
+                   and bool(np.any(new[:, window] != old[:, window]))
+                   for new, old in ((pattern.engaged, modes.engaged),
+                                    (pattern.sliding, modes.sliding)))]
+
+
 def _plan_of(solve: ModeSolve, transcription: Transcription) -> Plan:
     arrays, final_time = read_solution(*values_at(transcription.problem, solve.modes,
                                                   solve.point, transcription))
@@ -375,7 +391,8 @@ def _reference_plan(reference: Reference) -> Plan:
 
 
 __all__ = [
-    "GOAL_TOLERANCE_FRACTION", "MAX_REPLAN_GROWTH", "MIN_HORIZON", "NLP_CACHE_SIZE",
+    "GOAL_TOLERANCE_FRACTION", "MAX_REPLAN_GROWTH", "MIN_HORIZON", "NEIGHBOUR_WINDOW",
+    "NLP_CACHE_SIZE",
     "PLAN_IMPULSES", "STEP_MAX_ITERATIONS",
     "MPCStep", "Plan", "ShrinkingHorizonMPC",
 ]

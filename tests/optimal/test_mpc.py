@@ -10,7 +10,7 @@ casadi = pytest.importorskip("casadi")
 from mdi_envs.rollout import rollout  # noqa: E402
 from optimal.continuation import solve_continuation  # noqa: E402
 from optimal.modes import ModePattern  # noqa: E402
-from optimal.mpc import Plan, ShrinkingHorizonMPC  # noqa: E402
+from optimal.mpc import NEIGHBOUR_WINDOW, Plan, ShrinkingHorizonMPC, _imminent_neighbours  # noqa: E402
 from optimal.problems import make_problem  # noqa: E402
 from optimal.references import Reference  # noqa: E402
 from optimal.replay import env_options  # noqa: E402
@@ -90,3 +90,16 @@ def test_plan_shift_and_regrid_keep_the_trajectory() -> None:
     last = Plan(q[-2:], q[-2:], np.ones((1, 1)), ModePattern(engaged=np.array([[True]])), 0.25)
     held = last.shifted(2)
     assert held.num_intervals == 2 and np.allclose(held.q, q[-1])
+
+
+def test_the_neighbour_fallback_moves_only_imminent_modes() -> None:
+    sliding = np.zeros((2, 12), dtype=bool)
+    sliding[0, 2:6] = True  # a switch inside the window and one beyond it
+    sliding[1, 8:] = True  # switches only beyond it
+    modes = ModePattern(sliding=sliding)
+    kept = _imminent_neighbours(modes)
+    kept_keys = {pattern.key() for pattern in kept}
+    assert kept
+    for _, pattern in modes.neighbours(max_shift=1):
+        changed = np.flatnonzero((pattern.sliding != sliding).any(axis=0))
+        assert (pattern.key() in kept_keys) == (changed.min() < NEIGHBOUR_WINDOW)
