@@ -1,10 +1,12 @@
 """Global search for a reference: many starts, each continued and then mode-neighbourhood searched.
 
-One start = (label, t_f guess, an optional mode pattern). The pattern, when given, is solved
-first with its modes fixed (``optimal.mode_search.solve_with_modes``, from the naive guess) and
-that point starts the penalty/continuation; without one, the continuation starts from the naive
-guess. The continuation's optimum is re-solved with its modes fixed and then improved by
-``improve_modes`` (switches shifted by +-1, +-2 intervals, phases merged or split). The starts:
+One start = (label, t_f guess, an optional mode pattern, an optional bend of the naive guess).
+The pattern, when given, is solved first with its modes fixed
+(``optimal.mode_search.solve_with_modes``, from the start's guess) and, if that converges, its
+optimum starts the penalty/continuation; otherwise the continuation starts from the start's
+guess (the naive one, bent by ``bump``). The continuation's optimum is re-solved with its
+modes fixed and then improved by ``improve_modes`` (switches shifted by +-1, +-2 intervals,
+phases merged or split). The starts:
 
 * ``naive guess``: the problem's own guess, as ``mdi-envs optimize`` solves it;
 * ``paper schedule`` (manipulator): the brake schedule of the paper's Fig. 3 (engaged 0-0.41,
@@ -12,7 +14,8 @@ guess. The continuation's optimum is re-solved with its modes fixed and then imp
 * ``random i``: t_f guess drawn uniformly in ``RANDOM_TIME_FACTORS`` x the problem's guess
   (time-optimal problems) and a random pattern: per brake or contact row, 0 to
   ``RANDOM_MAX_PHASES`` phases of the non-default mode (engaged; sliding) at random places and
-  lengths.
+  lengths; where the problem has a ``guess_bend_scale`` (the robot), the guess bent by a
+  half sine of amplitude uniform in +-scale per coordinate (another path through the plane).
 
 Starts run in worker processes (``workers``), with a progress bar; each returns plain data.
 ``GlobalSearch`` keeps every start's continuation optimum and local optimum, the best, and the
@@ -58,11 +61,13 @@ class Start:
         label: "naive guess", "paper schedule" or "random i".
         final_time: the t_f guess [s] (the fixed t_f of effort problems).
         modes: the pattern solved first with modes fixed, or None (naive guess only).
+        bump: (n,) the bend of the naive guess (``Transcription.set_naive_guess``), or None.
     """
 
     label: str
     final_time: float
     modes: ModePattern | None = None
+    bump: tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,14 +75,17 @@ class StartResult:
     """What one start found.
 
     Attributes:
-        start: the start. continuation_cost: the cost where the continuation ended (nan if it
-            did not converge). continuation_success: it converged.
+        start: the start. pattern_converged: its pattern's fixed solve converged (and started
+            the continuation); False also without a pattern. continuation_cost: the cost
+            where the continuation ended (nan if it did not converge). continuation_success:
+            it converged.
         local: the mode-neighbourhood search from the continuation's optimum (None when the
             continuation's optimum could not be re-solved with its modes fixed).
         wall_time: [s] of the whole start.
     """
 
     start: Start
+    pattern_converged: bool
     continuation_cost: float
     continuation_success: bool
     local: LocalSearch | None
@@ -93,6 +101,7 @@ class StartResult:
         local = self.local
         return {
             "label": self.start.label, "guess_final_time": self.start.final_time,
+            "guess_bend": self.start.bump, "pattern_converged": self.pattern_converged,
             "continuation_cost": self.continuation_cost,
             "continuation_converged": self.continuation_success,
             "local_cost": None if local is None else local.best.cost,
@@ -176,8 +185,10 @@ def make_starts(problem: OptimalControlProblem, count: int, seed: int = 0) -> li
     rng = np.random.default_rng(seed)
     for index in range(count - len(starts)):
         factor = rng.uniform(*RANDOM_TIME_FACTORS) if problem.cost == "time" else 1.0
-        starts.append(Start(f"random {index}", factor * problem.final_time,
-                            _random_pattern(problem, rng)))
+        pattern = _random_pattern(problem, rng)
+        scale = np.asarray(problem.guess_bend_scale, dtype=float)
+        bump = tuple(rng.uniform(-scale, scale).tolist()) if scale.size else None
+        starts.append(Start(f"random {index}", factor * problem.final_time, pattern, bump))
     return starts[:count]
 
 
@@ -204,11 +215,15 @@ def run_start(problem: OptimalControlProblem, start: Start, schedule: Schedule |
     """One start (see the module docstring); runs in a worker process."""
     clock = time.perf_counter()
     problem = dataclasses.replace(problem, final_time=start.final_time)
-    initial = None
-    if start.modes is not None:
-        fixed = solve_with_modes(problem, start.modes)
-        initial = fixed.point if np.all(np.isfinite(fixed.point)) else None
     transcription = Transcription(problem)
+    transcription.set_naive_guess(None if start.bump is None else np.asarray(start.bump))
+    initial = transcription.initial_point()
+    pattern_converged = False
+    if start.modes is not None:
+        fixed = solve_with_modes(problem, start.modes, initial=initial)
+        pattern_converged = fixed.success
+        if fixed.success:
+            initial = fixed.point
     result = solve_continuation(transcription, schedule, initial=initial)
     solved = result.transcription or transcription
     cost = float(result.values(solved.cost)) if result.success else float("nan")
@@ -218,7 +233,7 @@ def run_start(problem: OptimalControlProblem, start: Start, schedule: Schedule |
         first = solve_with_modes(problem, read_modes(solved, result.values), initial=point)
         if first.success:
             local = improve_modes(problem, first, max_shift=max_shift)
-    return StartResult(start=start, continuation_cost=cost,
+    return StartResult(start=start, pattern_converged=pattern_converged, continuation_cost=cost,
                        continuation_success=result.success, local=local,
                        wall_time=time.perf_counter() - clock)
 

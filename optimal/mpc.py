@@ -308,8 +308,7 @@ class ShrinkingHorizonMPC:
         start_q, start_u = guess.q.copy(), guess.u.copy()
         start_q[0], start_u[0] = q, u
         transcription.set_guess(start_q, start_u, guess.tau, guess.final_time, guess.impulses)
-        opti = transcription.opti
-        initial = np.asarray(opti.value(opti.x, opti.initial()), dtype=float).ravel()
+        initial = transcription.initial_point()
         solve, transcription = self._fixed(guess.modes, False, q, u, initial)
         if self._acceptable(solve, guess):
             return solve, _plan_of(solve, transcription), ""

@@ -104,8 +104,7 @@ def refine(problem: OptimalControlProblem, solve: ModeSolve, factors: Sequence[i
         pattern = previous.solve.modes.refined(factor // previous.factor)
         guess = Transcription(fine, modes=pattern)
         _interpolated_guess(guess, previous)
-        start = np.asarray(guess.opti.value(guess.opti.x, guess.opti.initial()), dtype=float)
-        fixed = solve_with_modes(fine, pattern, initial=start.ravel(), transcription=guess,
+        fixed = solve_with_modes(fine, pattern, initial=guess.initial_point(), transcription=guess,
                                  mu_strategy=mu_strategy)
         best = fixed
         transcription = Transcription(fine)

@@ -100,6 +100,9 @@ class OptimalControlProblem:
         goal_q_tolerance: |q_i(t_f) - goal| <= this for the ``goal_q`` entries [rad or m]; 0
             imposes the goal exactly (every reference; the MPC's fallback relaxes it).
         goal_u_tolerance: the same for ``goal_u`` [rad/s or m/s].
+        guess_bend_scale: (n,) largest amplitude per coordinate of the half-sine bends the
+            global search's random starts add to the naive guess (``set_naive_guess(bump)``);
+            () keeps their guesses straight.
     """
 
     name: str
@@ -124,6 +127,7 @@ class OptimalControlProblem:
     description: str = ""
     goal_q_tolerance: float = 0.0
     goal_u_tolerance: float = 0.0
+    guess_bend_scale: tuple[float, ...] = ()
 
 
 @dataclass
@@ -328,23 +332,37 @@ class Transcription:
         for parameter, value in zip(self._start, (q, u), strict=True):
             self.opti.set_value(parameter, np.asarray(value, dtype=float))
 
-    def set_naive_guess(self) -> None:
-        """The documented naive initial guess.
+    def set_naive_guess(self, bump: FloatArray | None = None) -> None:
+        """The documented naive initial guess, optionally bent.
 
         Coordinates interpolate linearly from ``initial_q`` to ``guess_final_q`` over t_f (the
         problem's ``final_time``), velocities are that interpolation's constant rate, inputs
         are zero, brakes released and impulses zero; every slack takes the value its defining
         equation gives at this guess.
+
+        Args:
+            bump: (n,) amplitudes of a half sine, bump * sin(pi t / t_f), added to the
+                coordinates (and its derivative to the velocities): the same ends, another
+                path between them (the global search's random starts). None: straight.
         """
         pr = self.problem
         big_n = pr.num_intervals
         start = np.asarray(pr.initial_q, dtype=float)
         end = np.asarray(pr.guess_final_q, dtype=float)
         weights = np.linspace(0.0, 1.0, big_n + 1)
-        rate = (end - start) / pr.final_time
-        self.set_guess(start[None, :] + (end - start)[None, :] * weights[:, None],
-                       np.repeat(rate[None, :], big_n + 1, axis=0),
-                       np.zeros((big_n, pr.model.NUM_INPUTS)), pr.final_time)
+        q = start[None, :] + (end - start)[None, :] * weights[:, None]
+        u = np.repeat(((end - start) / pr.final_time)[None, :], big_n + 1, axis=0)
+        if bump is not None:
+            amplitude = np.asarray(bump, dtype=float)
+            if amplitude.shape != start.shape:
+                raise ValueError(f"bump must have shape {start.shape}, got {amplitude.shape}")
+            q = q + amplitude[None, :] * np.sin(np.pi * weights)[:, None]
+            u = u + amplitude[None, :] * (np.pi / pr.final_time) * np.cos(np.pi * weights)[:, None]
+        self.set_guess(q, u, np.zeros((big_n, pr.model.NUM_INPUTS)), pr.final_time)
+
+    def initial_point(self) -> FloatArray:
+        """(nx,) the NLP point of the current initial guess (``set_guess``, ``set_naive_guess``)."""
+        return np.asarray(self.opti.value(self.opti.x, self.opti.initial()), dtype=float).ravel()
 
     def set_guess(self, q: FloatArray, u: FloatArray, tau: FloatArray,
                   final_time: float, impulses: dict[str, FloatArray] | None = None) -> None:

@@ -59,6 +59,7 @@ from optimal.references import Reference  # noqa: E402
 from optimal.refinement import refine  # noqa: E402
 from optimal.replay import replay  # noqa: E402
 from optimal.solution import read_solution, values_at  # noqa: E402
+from optimal.transcription import Transcription  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -131,4 +132,28 @@ def test_starts_include_the_naive_guess_the_paper_schedule_and_random_ones() -> 
     with pytest.raises(ValueError, match="at least 1"):
         make_starts(problem, 0)
     effort = dataclasses.replace(make_problem("diff_drive_effort"))
-    assert all(s.final_time == effort.final_time for s in make_starts(effort, 3))
+    robot_starts = make_starts(effort, 3)
+    assert all(s.final_time == effort.final_time for s in robot_starts)
+    # the robot's random starts bend the path within its scale; the manipulator's stay straight
+    assert robot_starts[0].bump is None and all(s.bump is None for s in starts)
+    scale = np.asarray(effort.guess_bend_scale)
+    for start in robot_starts[1:]:
+        assert np.all(np.abs(start.bump) <= scale) and np.any(np.asarray(start.bump) != 0)
+
+
+def test_a_bent_guess_keeps_its_ends_and_its_velocities_match_the_path() -> None:
+    problem = make_problem("diff_drive_time", 40)
+    transcription = Transcription(problem)
+    bump = np.array([1.0, -0.5, 0.3, 0.0, 0.0])
+    transcription.set_naive_guess(bump)
+    opti = transcription.opti
+    q = np.asarray(opti.value(transcription.q, opti.initial())).T
+    u = np.asarray(opti.value(transcription.u, opti.initial())).T
+    np.testing.assert_allclose(q[0], problem.initial_q, atol=1e-12)
+    np.testing.assert_allclose(q[-1], problem.guess_final_q, atol=1e-12)
+    np.testing.assert_allclose(q[20] - (np.asarray(problem.initial_q)
+                                        + np.asarray(problem.guess_final_q)) / 2, bump, atol=1e-12)
+    h = problem.final_time / problem.num_intervals  # central differences of q match u
+    np.testing.assert_allclose((q[2:] - q[:-2]) / (2 * h), u[1:-1], rtol=0, atol=1e-2)
+    with pytest.raises(ValueError, match="bump must have shape"):
+        transcription.set_naive_guess(np.zeros(2))
