@@ -125,8 +125,13 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
     conditions += [{"label": label, "scale": DEFAULT_SCALE, "mismatch": label}
                    for label, _ in MISMATCHES[env_id] if mismatches]
     factories = dict(MISMATCHES[env_id])
+    available = controllers_for(env_id, task, mpc, trained_dir)
+    unknown = sorted(set(only or ()) - {label for label, _ in available})
+    if unknown:
+        raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} task "
+                         f"{task!r}; known: {', '.join(label for label, _ in available)}")
     rows = []
-    for label, runs in controllers_for(env_id, task, mpc, trained_dir):
+    for label, runs in available:
         if only is not None and label not in only:
             continue
         results = []

@@ -67,3 +67,9 @@ def test_a_controller_rerun_merges_into_the_study(tmp_path: Path) -> None:
     assert row["results"][1]["success_rate"] == 0.0  # the open loop at 0.3 (as above)
     with pytest.raises(ValueError, match="seeds"):
         merge_studies(study, {**study, "seeds": 2})
+
+
+def test_an_unknown_controller_label_is_an_error(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=r"no controller 'PP0'.*known: optimal \(open loop\)"):
+        robustness(ROBOT, "effort", num_seeds=1, scales=(0.01,), trained_dir=tmp_path,
+                   mismatches=False, only=["PP0"])
