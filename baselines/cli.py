@@ -110,6 +110,10 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument("--mpc", action="store_true",
                         help="also play the shrinking-horizon MPC around the reference "
                         "(optimal.mpc; needs CasADi; 0.1-1 s of compute per env step)")
+    parser.add_argument("--controllers", nargs="+", default=None, metavar="LABEL",
+                        help="play only these rows (labels as in the table, e.g. PPO HybridPPO "
+                        "'MPC (shrinking horizon)') and merge them into the comparison JSON "
+                        "already in --output, keeping its other rows")
     parser.add_argument("--output", type=Path, default=Path("results/compare"),
                         help="folder for the JSON, PNG and Markdown results")
     parser.set_defaults(handler=run_compare)
@@ -118,9 +122,17 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 def run_compare(args: argparse.Namespace) -> int:
     """Handler of ``compare``: runs each env x task, prints and writes the table; returns 0."""
+    import json
     import sys
 
-    from baselines.compare import TASKS, TRAINED_DIR, collect_tables, compare, write_comparison
+    from baselines.compare import (
+        TASKS,
+        TRAINED_DIR,
+        collect_tables,
+        compare,
+        merge_comparisons,
+        write_comparison,
+    )
 
     if args.seeds < 1:
         raise SystemExit(f"compare: --seeds must be >= 1, got {args.seeds}")
@@ -139,9 +151,16 @@ def run_compare(args: argparse.Namespace) -> int:
             if controller is None:
                 raise SystemExit("compare: --mpc needs CasADi (pip install 'mdi-envs[optimal]')")
             extra.append(controller)
-        comparison = compare(env_id, task, num_seeds=args.seeds, trained_dir=trained_dir,
-                             bootstrap_reps=args.bootstrap_reps, extra_controllers=extra,
-                             log=lambda line: print(line, file=sys.stderr, flush=True))
+        try:
+            comparison = compare(env_id, task, num_seeds=args.seeds, trained_dir=trained_dir,
+                                 bootstrap_reps=args.bootstrap_reps, extra_controllers=extra,
+                                 log=lambda line: print(line, file=sys.stderr, flush=True),
+                                 only=args.controllers)
+        except ValueError as error:
+            raise SystemExit(f"compare: {error}") from error
+        previous = args.output / f"compare_{env_id.split('/')[-1]}_{task}.json"
+        if args.controllers is not None and previous.exists():
+            comparison = merge_comparisons(json.loads(previous.read_text()), comparison)
         for path in write_comparison(comparison, args.output, trained_dir):
             print(f"wrote {path}", file=sys.stderr)
     table = collect_tables(args.output)

@@ -63,6 +63,9 @@ SCHEDULE_KEYS = {"mdi_envs/BlockableManipulator-v0": "brake_engaged",
 OPTIMAL = "optimal (open loop)"
 """The label of the reference in tables and plots."""
 
+TRAJECTORY_FIELDS = ("time", "q", "schedule")
+"""The array fields of an ``Episode`` (kept in the JSON for nominal episodes only)."""
+
 SCORES = ("success_rate", "time_ratio", "effort_ratio")
 """The per-run scores aggregated over runs (``summarize`` keys)."""
 
@@ -122,7 +125,20 @@ class Episode:
     def scores(self) -> dict[str, Any]:
         """The scalar fields (for JSON)."""
         return {key: value for key, value in asdict(self).items()
-                if key not in ("time", "q", "schedule")}  # fmt: skip
+                if key not in TRAJECTORY_FIELDS}  # fmt: skip
+
+    def record(self) -> dict[str, Any]:
+        """The scalar fields and the trajectory (for JSON; ``from_record`` reads it back)."""
+        return {**self.scores(), "trajectory": {key: getattr(self, key).tolist()
+                                                for key in TRAJECTORY_FIELDS}}
+
+    @classmethod
+    def from_record(cls, record: dict[str, Any]) -> Episode:
+        """An ``Episode`` from ``scores()`` or ``record()`` (trajectory empty if not stored)."""
+        trajectory = record.get("trajectory", {})
+        scalars = {key: value for key, value in record.items() if key != "trajectory"}
+        return cls(**scalars, **{key: np.asarray(trajectory.get(key, []), dtype=float)
+                                 for key in TRAJECTORY_FIELDS})
 
 
 def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: int,
@@ -286,6 +302,7 @@ def compare(
     log: Callable[[str], None] | None = None,
     trained_dir: Path = TRAINED_DIR,
     bootstrap_reps: int | None = None,
+    only: Sequence[str] | None = None,
 ) -> dict[str, Any]:
     """Evaluate the controllers and every run of every trained algorithm on the same starts.
 
@@ -299,6 +316,8 @@ def compare(
         log: progress lines (default: none).
         trained_dir: where ``shipped_policies`` looks.
         bootstrap_reps: bootstrap replications (default ``baselines.aggregate.BOOTSTRAP_REPS``).
+        only: the row labels to play (e.g. ["PPO", "HybridPPO"]; None: all), for a comparison
+            completed row by row (``merge_comparisons``); an unknown label is a ValueError.
 
     Returns:
         {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort" [N^2 m^2 s],
@@ -320,6 +339,11 @@ def compare(
     for algo, paths in group_by_algorithm(configs).items():
         groups.append((algo, True, [load_policy(path) for path in paths]))
     groups += [(c.label, False, [(c, {})]) for c in extra_controllers]
+    unknown = sorted(set(only or ()) - {label for label, _, _ in groups})
+    if unknown:
+        raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} task "
+                         f"{task!r}; known: {', '.join(label for label, _, _ in groups)}")
+    groups = [group for group in groups if only is None or group[0] in only]
     rows = []
     for label, trained, members in groups:
         runs = []
@@ -414,18 +438,45 @@ def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
 
 
 def comparison_record(comparison: dict[str, Any]) -> dict[str, Any]:
-    """The comparison as plain JSON (episodes as their scores, no trajectories)."""
+    """The comparison as plain JSON; ``merge_comparisons`` reads it back.
+
+    Perturbed episodes as their scores, nominal episodes with their trajectories.
+    """
     record = {k: v for k, v in comparison.items() if k != "controllers"}
     record["controllers"] = [
         {"label": row["label"], "algo": row["algo"], "trained": row["trained"],
          "aggregate": row["aggregate"],
          "runs": [{"seed": run["seed"], "config": run["config"], "summary": run["summary"],
-                   "nominal": run["nominal"].scores(),
+                   "nominal": run["nominal"].record(),
                    "episodes": [e.scores() for e in run["episodes"]]}
                   for run in row["runs"]]}
         for row in comparison["controllers"]
     ]  # fmt: skip
     return record
+
+
+def merge_comparisons(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
+    """``new``'s rows over ``old``'s (a ``comparison_record``, e.g. the JSON in the output).
+
+    Rows with the same label are replaced, the others kept in ``old``'s order and ``new``'s
+    added after them. Both must compare the same env, task, reference (same optimum) and starts.
+    Kept rows come back as ``Episode`` objects (perturbed episodes without trajectories).
+    """
+    for key in ("env_id", "task", "reference", "optimal_time", "optimal_effort", "seeds"):
+        if old.get(key) != new[key]:
+            raise ValueError(f"cannot merge comparisons with different {key}: "
+                             f"{old.get(key)!r} and {new[key]!r}")
+    replaced = {row["label"]: row for row in new["controllers"]}
+    rows = []
+    for row in old["controllers"]:
+        if row["label"] in replaced:
+            rows.append(replaced.pop(row["label"]))
+            continue
+        runs = [{**run, "nominal": Episode.from_record(run["nominal"]),
+                 "episodes": [Episode.from_record(e) for e in run["episodes"]]}
+                for run in row["runs"]]  # fmt: skip
+        rows.append({**row, "runs": runs})
+    return {**new, "controllers": rows + list(replaced.values())}
 
 
 def write_comparison(comparison: dict[str, Any], output: Path,
@@ -472,8 +523,10 @@ def collect_tables(output: Path) -> str:
 
 __all__ = [
     "CONTROLLER_FACTORIES", "OPTIMAL", "REFERENCE_NAMES", "SCORES", "TASKS", "TRAINED_DIR",
+    "TRAJECTORY_FIELDS",
     "Controller", "Episode", "aggregate_runs", "collect_tables", "compare", "comparison_record",
     "evaluate_controller", "group_by_algorithm", "interval_text", "load_policy",
-    "markdown_table", "optimal_controller", "play", "reference_controller", "reference_effort",
-    "registered_controllers", "shipped_policies", "summarize", "write_comparison",
+    "markdown_table", "merge_comparisons", "optimal_controller", "play", "reference_controller",
+    "reference_effort", "registered_controllers", "shipped_policies", "summarize",
+    "write_comparison",
 ]

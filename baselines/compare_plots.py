@@ -56,6 +56,8 @@ def _trajectory_panels(axes: Any, comparison: dict[str, Any]) -> None:
 
 def _draw(axes: Any, episode: Any, robot: bool, style: dict[str, Any]) -> None:
     q, t = episode.q, episode.time
+    if not q.size:  # a row merged from a JSON without its trajectories
+        return
     if robot:
         axes[0].plot(q[:, 0], q[:, 1], **style)
         axes[1].plot(t, q[:, 2], **style)
@@ -70,6 +72,8 @@ def _schedule_panel(ax: Any, comparison: dict[str, Any]) -> None:
     for level, row in enumerate(rows):
         episode = row["runs"][0]["nominal"]
         t, schedule = episode.time, episode.schedule
+        if not schedule.size:
+            continue
         if robot:
             for mode, colour in MODE_COLOURS.items():
                 on = np.append(schedule == mode, False)

@@ -21,6 +21,7 @@ from baselines.compare import (
     group_by_algorithm,
     interval_text,
     markdown_table,
+    merge_comparisons,
     reference_controller,
     reference_effort,
     registered_controllers,
@@ -189,6 +190,29 @@ def test_compare_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert (tmp_path / "compare_BlockableManipulator-v0_time.png").exists()
     with pytest.raises(SystemExit, match="has no task"):
         main(["compare", MANIPULATOR, "--task", "effort", "--output", str(tmp_path)])
+
+
+def test_a_row_rerun_merges_into_the_comparison(tmp_path: Path) -> None:
+    from mdi_envs.cli import main
+
+    common = ["compare", DIFF_DRIVE, "--task", "effort", "--seeds", "1", "--trained", str(tmp_path),
+              "--output", str(tmp_path)]  # fmt: skip
+    assert main(common) == 0
+    path = tmp_path / "compare_DiffDriveRobot-v0_effort.json"
+    first = json.loads(path.read_text())
+    nominal = first["controllers"][0]["runs"][0]["nominal"]
+    assert len(nominal["trajectory"]["q"]) == nominal["num_steps"] + 1  # kept for merges
+    kept = {**first, "controllers": [{**first["controllers"][0], "label": "kept row"}]}
+    path.write_text(json.dumps(kept))
+    assert main([*common, "--controllers", OPTIMAL]) == 0
+    merged = json.loads(path.read_text())
+    assert [row["label"] for row in merged["controllers"]] == ["kept row", OPTIMAL]
+    assert merged["controllers"][0]["runs"] == first["controllers"][0]["runs"]
+    assert "| kept row |" in (tmp_path / "compare.md").read_text()
+    with pytest.raises(SystemExit, match="no controller 'PP0'"):
+        main([*common, "--controllers", "PP0"])
+    with pytest.raises(ValueError, match="different seeds"):
+        merge_comparisons(merged, {**merged, "seeds": [0, 1]})
 
 
 @pytest.mark.slow
