@@ -47,7 +47,7 @@ from optimal.problems import make_problem
 from optimal.references import Reference
 from optimal.solution import SLIP_TOLERANCE, read_modes, read_solution, values_at
 from optimal.solve import SCHEDULES
-from optimal.transcription import Transcription
+from optimal.transcription import GUESS_IMPULSES, Transcription
 
 MIN_HORIZON = 1
 """Fewest intervals a time-optimal re-solve plans over. The horizon is re-gridded to keep each
@@ -61,11 +61,6 @@ GOAL_TOLERANCE_FRACTION = 0.5
 """Where the exact goal is infeasible from the measured state (an underactuated link off its
 plan by float32 rounding cannot be steered back within a fixed pattern), the re-solve asks for
 the goal within this fraction of the task's success tolerances."""
-
-PLAN_IMPULSES = ("tangent_impulse", "slip_speed")
-"""The per-interval solution arrays a plan carries into the next warm start: the robot's
-friction (``Transcription.set_guess``). The brake impulses are not carried: warm-started with
-them, the nominal N = 40 manipulator run left its plan at step 24 and took 7 % longer."""
 
 NLP_CACHE_SIZE = 400
 """Fixed-pattern NLPs a controller keeps (least recently used dropped). Each takes about 11 MB
@@ -91,8 +86,10 @@ class Plan:
     Attributes:
         q: (N+1, n). u: (N+1, n). tau: (N, m) [N m]. modes: the pattern (N intervals).
         final_time: its duration [s].
-        impulses: per-interval impulses and slip speeds by output name (``PLAN_IMPULSES``),
-            each (N, ·), the rest of the warm start (``Transcription.set_guess``).
+        impulses: per-interval impulses and slip speeds by output name (``GUESS_IMPULSES``),
+            each (N, ·), the rest of the warm start (``Transcription.set_guess``). The brake
+            impulses are not carried: warm-started with them, the nominal N = 40 manipulator
+            run left its plan at step 24 and took 7 % longer.
     """
 
     q: FloatArray
@@ -372,7 +369,7 @@ def _plan_of(solve: ModeSolve, transcription: Transcription) -> Plan:
     arrays, final_time = read_solution(*values_at(transcription.problem, solve.modes,
                                                   solve.point, transcription))
     return Plan(arrays["q"], arrays["u"], arrays["tau"], solve.modes, final_time,
-                {key: arrays[key] for key in PLAN_IMPULSES if key in arrays})
+                {key: arrays[key] for key in GUESS_IMPULSES if key in arrays})
 
 
 def _reference_plan(reference: Reference) -> Plan:
@@ -386,12 +383,11 @@ def _reference_plan(reference: Reference) -> Plan:
                 np.asarray(reference.tau, dtype=float), ModePattern(engaged, sliding),
                 float(reference.final_time),
                 {key: np.asarray(reference.arrays[key], dtype=float)
-                 for key in PLAN_IMPULSES if key in reference.arrays})
+                 for key in GUESS_IMPULSES if key in reference.arrays})
 
 
 __all__ = [
     "GOAL_TOLERANCE_FRACTION", "MAX_REPLAN_GROWTH", "MIN_HORIZON", "NEIGHBOUR_WINDOW",
-    "NLP_CACHE_SIZE",
-    "PLAN_IMPULSES", "STEP_MAX_ITERATIONS",
+    "NLP_CACHE_SIZE", "STEP_MAX_ITERATIONS",
     "MPCStep", "Plan", "ShrinkingHorizonMPC",
 ]

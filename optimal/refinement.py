@@ -28,7 +28,7 @@ import numpy as np
 from optimal.continuation import Schedule, solve_continuation
 from optimal.mode_search import ModeSolve, improve_modes, solve_with_modes
 from optimal.solution import read_modes, read_solution, values_at
-from optimal.transcription import OptimalControlProblem, Transcription
+from optimal.transcription import GUESS_IMPULSES, OptimalControlProblem, Transcription
 
 FREEING_SCHEDULE = Schedule(penalties=(1e3,), relaxations=(1e-10,))
 """The continuation's last stage (and its polish), run from the fixed-pattern point."""
@@ -131,8 +131,10 @@ def refine(problem: OptimalControlProblem, solve: ModeSolve, factors: Sequence[i
 def _interpolated_guess(fine: Transcription, coarse: Level) -> None:
     """Set ``fine``'s initial guess to the coarse level's trajectory.
 
-    q and u linearly interpolated, inputs held, t_f kept; impulses zero, slacks consistent
-    (``Transcription.set_guess``).
+    q and u linearly interpolated, inputs held, t_f kept; the friction impulses
+    (``GUESS_IMPULSES``) held and divided by the refinement ratio, slip speeds held, the other
+    impulses zero, slacks consistent (``Transcription.set_guess``). Without the friction, the
+    robot's time-optimal refinement from N = 25 to 50 did not converge.
     """
     arrays, final_time = read_solution(*values_at(coarse.problem, coarse.solve.modes,
                                                   coarse.solve.point))
@@ -145,8 +147,10 @@ def _interpolated_guess(fine: Transcription, coarse: Level) -> None:
         return np.column_stack([np.interp(fine_time, coarse_time, column)
                                 for column in values.T])
 
+    impulses = {key: np.repeat(arrays[key], ratio, axis=0) / (1 if key == "slip_speed" else ratio)
+                for key in GUESS_IMPULSES if key in arrays}  # an impulse per interval scales with h
     fine.set_guess(interpolated(arrays["q"]), interpolated(arrays["u"]),
-                   np.repeat(arrays["tau"], ratio, axis=0), final_time)
+                   np.repeat(arrays["tau"], ratio, axis=0), final_time, impulses)
 
 
 def _phases(solve: ModeSolve) -> dict[str, list[tuple[float, float]]]:
