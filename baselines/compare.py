@@ -136,9 +136,11 @@ class Episode:
     def from_record(cls, record: dict[str, Any]) -> Episode:
         """An ``Episode`` from ``scores()`` or ``record()`` (trajectory empty if not stored)."""
         trajectory = record.get("trajectory", {})
-        scalars = {key: value for key, value in record.items() if key != "trajectory"}
-        return cls(**scalars, **{key: np.asarray(trajectory.get(key, []), dtype=float)
-                                 for key in TRAJECTORY_FIELDS})
+        fields: dict[str, Any] = {key: value for key, value in record.items()
+                                  if key != "trajectory"}
+        fields.update({key: np.asarray(trajectory.get(key, []), dtype=float)
+                       for key in TRAJECTORY_FIELDS})
+        return cls(**fields)
 
 
 def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: int,
