@@ -341,10 +341,7 @@ def compare(
     for algo, paths in group_by_algorithm(configs).items():
         groups.append((algo, True, [load_policy(path) for path in paths]))
     groups += [(c.label, False, [(c, {})]) for c in extra_controllers]
-    unknown = sorted(set(only or ()) - {label for label, _, _ in groups})
-    if unknown:
-        raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} task "
-                         f"{task!r}; known: {', '.join(label for label, _, _ in groups)}")
+    require_known_labels(only, [label for label, _, _ in groups], env_id, task)
     groups = [group for group in groups if only is None or group[0] in only]
     rows = []
     for label, trained, members in groups:
@@ -363,6 +360,15 @@ def compare(
     return {"env_id": env_id, "task": task, "reference": reference.name,
             "optimal_time": optimal_time, "optimal_effort": optimal_effort, "seeds": seeds,
             "controllers": rows}  # fmt: skip
+
+
+def require_known_labels(only: Sequence[str] | None, known: Sequence[str], env_id: str,
+                         task: str) -> None:
+    """Raise ValueError naming the labels of ``only`` that are not in ``known``."""
+    unknown = sorted(set(only or ()) - set(known))
+    if unknown:
+        raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} task "
+                         f"{task!r}; known: {', '.join(known)}")
 
 
 def budget_text(row: dict[str, Any]) -> str:
@@ -529,6 +535,6 @@ __all__ = [
     "Controller", "Episode", "aggregate_runs", "collect_tables", "compare", "comparison_record",
     "evaluate_controller", "group_by_algorithm", "interval_text", "load_policy",
     "markdown_table", "merge_comparisons", "optimal_controller", "play", "reference_controller",
-    "reference_effort", "registered_controllers", "shipped_policies", "summarize",
-    "write_comparison",
+    "reference_effort", "registered_controllers", "require_known_labels", "shipped_policies",
+    "summarize", "write_comparison",
 ]

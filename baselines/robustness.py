@@ -42,6 +42,7 @@ from baselines.compare import (
     play,
     reference_effort,
     registered_controllers,
+    require_known_labels,
     shipped_policies,
     summarize,
 )
@@ -126,10 +127,7 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                    for label, _ in MISMATCHES[env_id] if mismatches]
     factories = dict(MISMATCHES[env_id])
     available = controllers_for(env_id, task, mpc, trained_dir)
-    unknown = sorted(set(only or ()) - {label for label, _ in available})
-    if unknown:
-        raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} task "
-                         f"{task!r}; known: {', '.join(label for label, _ in available)}")
+    require_known_labels(only, [label for label, _ in available], env_id, task)
     rows = []
     for label, runs in available:
         if only is not None and label not in only:

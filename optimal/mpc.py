@@ -47,7 +47,7 @@ from optimal.problems import make_problem
 from optimal.references import Reference
 from optimal.solution import SLIP_TOLERANCE, read_modes, read_solution, values_at
 from optimal.solve import SCHEDULES
-from optimal.transcription import GUESS_IMPULSES, Transcription
+from optimal.transcription import GUESS_IMPULSES, Transcription, regridded_impulses
 
 MIN_HORIZON = 1
 """Fewest intervals a time-optimal re-solve plans over. The horizon is re-gridded to keep each
@@ -72,7 +72,7 @@ the same (intervals, pattern) keys, so from the second episode on most steps reu
 NEIGHBOUR_WINDOW = 3
 """The neighbouring-pattern fallback tries only the moves that change one of the next this-many
 intervals: a measured state off the plan puts the imminent mode in doubt, not a switch seconds
-ahead. All neighbours of a robot plan (4 contacts) were 20-27 new NLPs, 30-50 s per fallback."""
+ahead. All neighbours of a robot plan (3 contacts) were 20-27 new NLPs, 30-50 s per fallback."""
 
 MAX_REPLAN_GROWTH = 1.5
 """A time-optimal re-plan longer than this times the previous remaining time (plus one step)
@@ -142,9 +142,7 @@ class Plan:
 
         modes = ModePattern(*(None if rows is None else rows[:, holder]
                               for rows in (self.modes.engaged, self.modes.sliding)))
-        ratio = self.num_intervals / num_intervals
-        impulses = {key: value[holder] * (1.0 if key == "slip_speed" else ratio)
-                    for key, value in self.impulses.items()}
+        impulses = regridded_impulses(self.impulses, holder, self.num_intervals / num_intervals)
         return Plan(interpolated(self.q), interpolated(self.u), self.tau[holder], modes,
                     self.final_time, impulses)
 

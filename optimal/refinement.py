@@ -28,7 +28,12 @@ import numpy as np
 from optimal.continuation import Schedule, solve_continuation
 from optimal.mode_search import ModeSolve, improve_modes, solve_with_modes
 from optimal.solution import read_modes, read_solution, values_at
-from optimal.transcription import GUESS_IMPULSES, OptimalControlProblem, Transcription
+from optimal.transcription import (
+    GUESS_IMPULSES,
+    OptimalControlProblem,
+    Transcription,
+    regridded_impulses,
+)
 
 FREEING_SCHEDULE = Schedule(penalties=(1e3,), relaxations=(1e-10,))
 """The continuation's last stage (and its polish), run from the fixed-pattern point."""
@@ -147,8 +152,9 @@ def _interpolated_guess(fine: Transcription, coarse: Level) -> None:
         return np.column_stack([np.interp(fine_time, coarse_time, column)
                                 for column in values.T])
 
-    impulses = {key: np.repeat(arrays[key], ratio, axis=0) / (1 if key == "slip_speed" else ratio)
-                for key in GUESS_IMPULSES if key in arrays}  # an impulse per interval scales with h
+    impulses = regridded_impulses({key: arrays[key] for key in GUESS_IMPULSES if key in arrays},
+                                  np.repeat(np.arange(coarse.problem.num_intervals), ratio),
+                                  1.0 / ratio)
     fine.set_guess(interpolated(arrays["q"]), interpolated(arrays["u"]),
                    np.repeat(arrays["tau"], ratio, axis=0), final_time, impulses)
 

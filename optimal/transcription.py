@@ -79,6 +79,20 @@ them (a fixed-pattern solve from its own optimum's trajectory without them: 200+
 9 % off; with them 14)."""
 
 
+def regridded_impulses(impulses: dict[str, FloatArray], holder: np.ndarray,
+                       step_ratio: float) -> dict[str, FloatArray]:
+    """``GUESS_IMPULSES`` arrays moved to another grid of the same maneuver.
+
+    Args:
+        impulses: per-interval arrays by name, each (N_old, ·).
+        holder: (N_new,) the old interval each new interval takes its values from.
+        step_ratio: new interval length / old one. An impulse per interval scales with it,
+            a slip speed does not.
+    """
+    return {key: value[holder] * (1.0 if key == "slip_speed" else step_ratio)
+            for key, value in impulses.items()}
+
+
 @dataclass(frozen=True)
 class OptimalControlProblem:
     """A named instance of problem (34): model, boundary conditions, bounds, cost, grid.
@@ -694,4 +708,5 @@ __all__ = [
     "Pair",
     "Transcription",
     "numeric",
+    "regridded_impulses",
 ]
