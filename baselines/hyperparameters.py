@@ -57,11 +57,13 @@ from typing import Any
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
-ALGORITHMS = ("PPO", "SAC", "HybridPPO")
+ALGORITHMS = ("PPO", "SAC", "TQC", "CrossQ", "HybridPPO")
 """The algorithm names, canonical spelling (lookups are case-insensitive)."""
 ALGORITHM_CLASSES = {
     "PPO": "stable_baselines3:PPO",
     "SAC": "stable_baselines3:SAC",
+    "TQC": "sb3_contrib:TQC",
+    "CrossQ": "sb3_contrib:CrossQ",
     "HybridPPO": "baselines.hybrid_ppo:HybridPPO",
 }
 """Algorithm name -> "module:class" of its SB3-compatible class (imported on use, see

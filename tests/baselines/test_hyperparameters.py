@@ -21,7 +21,7 @@ HYPERPARAMETERS = hyperparameter_table()
 
 
 def test_table_covers_both_envs_tasks_and_algorithms() -> None:
-    assert len(HYPERPARAMETERS) == 7 and set(ALGORITHM_CLASSES) == set(ALGORITHMS)
+    assert len(HYPERPARAMETERS) == 13 and set(ALGORITHM_CLASSES) == set(ALGORITHMS)
     for (env_id, task, algo), entry in HYPERPARAMETERS.items():
         assert env_id in gym.registry and algo in ALGORITHMS and task in ("time", "effort")
         assert {"num_envs", "total_timesteps", "seed", "algo_kwargs", "env_kwargs",
@@ -97,3 +97,22 @@ def test_shipped_policies_were_trained_with_the_table() -> None:
         assert config["algo_kwargs"] == entry["algo_kwargs"], path.name
         assert config["env_kwargs"] == entry["env_kwargs"], path.name
         assert config.get("normalize_reward", False) == entry["normalize_reward"], path.name
+
+
+@pytest.mark.parametrize("algo", ["TQC", "CrossQ"])
+def test_the_off_policy_probes_share_sacs_budget_with_normalized_rewards(algo: str) -> None:
+    """TQC and CrossQ: SAC's copies, budget and replay ratio, and PPO's effort reward."""
+    for env_id, task in (("mdi_envs/BlockableManipulator-v0", "time"),
+                         ("mdi_envs/DiffDriveRobot-v0", "time"),
+                         ("mdi_envs/DiffDriveRobot-v0", "effort")):
+        entry = get_hyperparameters(env_id, algo, task)
+        sac = get_hyperparameters(env_id, "SAC", task)
+        shared = ("train_freq", "gradient_steps", "learning_starts", "batch_size")
+        assert (entry["num_envs"], entry["total_timesteps"]) == (sac["num_envs"],
+                                                                 sac["total_timesteps"])
+        assert [entry["algo_kwargs"][key] for key in shared] == [sac["algo_kwargs"][key]
+                                                                 for key in shared]
+        assert entry["normalize_reward"]
+        if task == "effort":
+            ppo = get_hyperparameters(env_id, "PPO", task)
+            assert entry["env_kwargs"] == ppo["env_kwargs"]

@@ -19,7 +19,8 @@ from baselines.hyperparameters import (
 
 pytest.importorskip("rl_zoo3", reason="rl-zoo3 is in the rl extra")
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
-ZOO_ALGOS = {"PPO": "ppo", "SAC": "sac", "HybridPPO": "hybridppo"}
+ZOO_ALGOS = {"PPO": "ppo", "SAC": "sac", "TQC": "tqc", "CrossQ": "crossq",
+             "HybridPPO": "hybridppo"}
 
 
 @pytest.mark.parametrize("key", sorted(hyperparameter_table()), ids=" ".join)
