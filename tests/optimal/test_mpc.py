@@ -103,3 +103,23 @@ def test_the_neighbour_fallback_moves_only_imminent_modes() -> None:
     for _, pattern in modes.neighbours(max_shift=1):
         changed = np.flatnonzero((pattern.sliding != sliding).any(axis=0))
         assert (pattern.key() in kept_keys) == (changed.min() < NEIGHBOUR_WINDOW)
+
+
+def test_a_plan_slightly_slower_than_h_still_shrinks(short_reference) -> None:  # noqa: ANN001
+    """The rest keeps N - 1 intervals within one step of (N - 1) h; re-grids only beyond."""
+    controller = ShrinkingHorizonMPC(short_reference)
+    h = controller.time_step
+
+    def plan(num_intervals: int, interval: float) -> Plan:
+        q = np.zeros((num_intervals + 1, 2))
+        return Plan(q, q.copy(), np.zeros((num_intervals, 1)),
+                    ModePattern(engaged=np.zeros((1, num_intervals), dtype=bool)),
+                    num_intervals * interval)
+
+    # intervals 0.7 % longer than h: rounding alone gives 97 again, the pattern never nears
+    assert round(96 * 1.007) == 97
+    assert controller._horizon_after_step(plan(97, 1.007 * h)) == 96
+    # a plan that has grown by more than a step is re-gridded to steps of h
+    assert controller._horizon_after_step(plan(20, 1.4 * h)) == 27  # 19 x 1.4 = 26.6
+    assert controller._horizon_after_step(plan(20, 0.6 * h)) == 11  # 19 x 0.6 = 11.4
+    assert controller._horizon_after_step(plan(1, h)) == 1  # held at min_horizon
