@@ -16,10 +16,10 @@ solve's last iterate, then re-solved with the modes it found), and last the prev
 next control open loop (``MPCStep.fallback``).
 
 Horizon: one env step is one interval (the env runs at the reference's h, ``env_options``).
-Time-optimal problems keep t_f free; the remaining plan keeps N - 1 intervals while its
-remaining time stays within one step h of (N - 1) h, and is re-gridded to
-max(round(t_remaining / h), ``min_horizon``) intervals beyond that, so a start that needs longer
-than the reference gets it; effort problems have t_f fixed, N - k intervals left at step k.
+Time-optimal problems keep t_f free; the remaining plan keeps N - 1 intervals while they
+stay within ``REGRID_TOLERANCE`` of h, and is re-gridded to max(round(t_remaining / h),
+``min_horizon``) intervals beyond that, so a start that needs longer than the reference gets
+it; effort problems have t_f fixed, N - k intervals left at step k.
 
 ``ShrinkingHorizonMPC(reference)`` is a policy: ``controller(observation) -> action`` in the
 env's default Box action space (the observation is decoded into (q, u): the manipulator's
@@ -74,6 +74,10 @@ NEIGHBOUR_WINDOW = 3
 """The neighbouring-pattern fallback tries only the moves that change one of the next this-many
 intervals: a measured state off the plan puts the imminent mode in doubt, not a switch seconds
 ahead. All neighbours of a robot plan (3 contacts) were 20-27 new NLPs, 30-50 s per fallback."""
+
+REGRID_TOLERANCE = 0.25
+"""A time-optimal plan is re-gridded to steps of h when its intervals differ from the env step
+h by more than this fraction (``ShrinkingHorizonMPC._horizon_after_step``)."""
 
 MAX_REPLAN_GROWTH = 1.5
 """A time-optimal re-plan longer than this times the previous remaining time (plus one step)
@@ -262,16 +266,19 @@ class ShrinkingHorizonMPC:
     def _horizon_after_step(self, plan: Plan) -> int:
         """Intervals of a time-optimal plan's rest: one fewer, or re-gridded to steps of h.
 
-        The rest keeps its N - 1 intervals while its remaining time is within one env step h
-        of (N - 1) h; only beyond that is it re-gridded to round(remaining / h) intervals
-        (at least ``min_horizon``). Re-gridding at every step (rounding alone) kept N when the
-        plan's intervals were 0.5 % longer than h: each step's 96 -> 97 re-grid moved the
-        pattern's next switch one interval back, so the plan never reached it (a 0.03-
-        perturbed manipulator episode planned 3.46 s to go for 27 steps and took 1.39x).
+        The rest keeps its N - 1 intervals while their length stays within
+        ``REGRID_TOLERANCE`` of the env step h; beyond that it is re-gridded to
+        round(remaining / h) intervals (at least ``min_horizon``). Each kept step shortens the
+        remaining time by h (the env's step) and the plan by one interval, so the plan's excess
+        over N h is carried unchanged and the next switch comes one interval nearer. Re-gridding
+        whenever rounding said so kept N at every step once the excess neared half a step, and
+        the plan stalled: its next switch stayed as far ahead (a 0.03-perturbed manipulator
+        episode planned 3.46 s to go for 27 steps and took 1.39x the optimum).
         """
         remaining = plan.final_time - plan.final_time / plan.num_intervals
         kept = plan.num_intervals - 1
-        if kept >= self.min_horizon and abs(remaining - kept * self.time_step) < self.time_step:
+        if kept >= self.min_horizon and abs(remaining / kept / self.time_step - 1.0) \
+                <= REGRID_TOLERANCE:
             return kept
         return max(int(round(remaining / self.time_step)), self.min_horizon)
 
@@ -401,6 +408,6 @@ def _reference_plan(reference: Reference) -> Plan:
 
 __all__ = [
     "GOAL_TOLERANCE_FRACTION", "MAX_REPLAN_GROWTH", "MIN_HORIZON", "NEIGHBOUR_WINDOW",
-    "NLP_CACHE_SIZE", "STEP_MAX_ITERATIONS",
+    "NLP_CACHE_SIZE", "REGRID_TOLERANCE", "STEP_MAX_ITERATIONS",
     "MPCStep", "Plan", "ShrinkingHorizonMPC",
 ]

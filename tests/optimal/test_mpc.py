@@ -106,7 +106,7 @@ def test_the_neighbour_fallback_moves_only_imminent_modes() -> None:
 
 
 def test_a_plan_slightly_slower_than_h_still_shrinks(short_reference) -> None:  # noqa: ANN001
-    """The rest keeps N - 1 intervals within one step of (N - 1) h; re-grids only beyond."""
+    """The rest keeps N - 1 intervals within ``REGRID_TOLERANCE`` of h; re-grids beyond."""
     controller = ShrinkingHorizonMPC(short_reference)
     h = controller.time_step
 
@@ -116,7 +116,7 @@ def test_a_plan_slightly_slower_than_h_still_shrinks(short_reference) -> None:  
                     ModePattern(engaged=np.zeros((1, num_intervals), dtype=bool)),
                     num_intervals * interval)
 
-    # intervals 0.7 % longer than h: rounding alone gives 97 again, the pattern never nears
+    # intervals 0.7 % longer than h: rounding alone gives 97 again, the next switch never nears
     assert round(96 * 1.007) == 97
     assert controller._horizon_after_step(plan(97, 1.007 * h)) == 96
     # a plan that has grown by more than a step is re-gridded to steps of h
