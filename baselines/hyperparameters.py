@@ -10,11 +10,11 @@ env argument ``task`` in ``env_kwargs``. An entry's rl-zoo3 keys map to ours: ``
 ``num_envs``, ``n_timesteps`` -> ``total_timesteps``, ``normalize: {norm_obs: false,
 norm_reward: true}`` -> ``normalize_reward`` (the only normalization used), ``env_kwargs`` as
 is, ``policy`` must be ``MlpPolicy``; every other key is an SB3 constructor argument
-(``algo_kwargs``). Algorithms: SB3's PPO and SAC on the default flattened Box action spaces,
-and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a categorical brake x Gaussian torque
-policy) on the manipulator's native ``action_mode="hybrid"`` space ``Tuple(Discrete(2),
-Box(-1, 1, (1,)))``; rl-zoo3 trains it through ``baselines.zoo``. Choices shared by every
-entry:
+(``algo_kwargs``). Algorithms: SB3's PPO and SAC and sb3-contrib's TQC and CrossQ on the
+default flattened Box action spaces, and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a
+categorical brake x Gaussian torque policy) on the manipulator's native
+``action_mode="hybrid"`` space ``Tuple(Discrete(2), Box(-1, 1, (1,)))``; rl-zoo3 trains it
+through ``baselines.zoo``. Choices shared by every entry:
 
 - ``gamma = 0.99`` for every algorithm. The env's shaping term is
   ``shaping_discount * Phi(s') - Phi(s)`` with Phi = -distance; every entry sets
@@ -38,6 +38,10 @@ entry:
   SAC's usual 1): a gradient step costs ~12-25 ms on this CPU whatever the width (overhead-
   bound), so the usual ratio would give ~40 transitions/s; 10^6 buffer, batch 256, 2 x 256 ReLU
   MLPs, automatic entropy tuning, 10^4 random warm-up steps.
+- TQC and CrossQ (the off-policy probe): SAC's copies, budget, warm-up, batch and replay
+  ratio, each algorithm's own learning rate and critics (CrossQ's 2 x 256, not its default
+  2 x 1024: ~150 ms per gradient step here), and the rewards normalized in training; on
+  "effort" PPO's reward (``goal_weight`` 1000).
 - Budgets, the ones of the shipped policies (``baselines/trained``): PPO 10^7 steps on the
   manipulator, 4 x 10^6 on diff drive "time", 5 x 10^6 on "effort", HybridPPO 5 x 10^6,
   SAC 10^6 (what fitted one session on the 2-core machine: PPO runs at about 3-15 k steps/s

@@ -22,8 +22,8 @@ checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched 
 with STEM = ``{env name}_{task}_{algo}_seed{seed}``, e.g. ``DiffDriveRobot-v0_effort_ppo_seed0``.
 
 The algorithm names and their classes are in ``baselines.hyperparameters`` (``ALGORITHMS``,
-``ALGORITHM_CLASSES``): SB3's PPO and SAC, and ``HybridPPO`` (``baselines.hybrid_ppo``) on the
-manipulator's hybrid action space.
+``ALGORITHM_CLASSES``): SB3's PPO and SAC, sb3-contrib's TQC and CrossQ, and ``HybridPPO``
+(``baselines.hybrid_ppo``) on the manipulator's hybrid action space.
 """
 
 from __future__ import annotations
