@@ -102,9 +102,9 @@ def test_shipped_policies_were_trained_with_the_table() -> None:
 @pytest.mark.parametrize("algo", ["TQC", "CrossQ"])
 def test_the_off_policy_probes_share_sacs_budget_with_normalized_rewards(algo: str) -> None:
     """TQC and CrossQ: SAC's copies, budget and replay ratio, and PPO's effort reward."""
-    for env_id, task in (("mdi_envs/BlockableManipulator-v0", "time"),
-                         ("mdi_envs/DiffDriveRobot-v0", "time"),
-                         ("mdi_envs/DiffDriveRobot-v0", "effort")):
+    tasks = [(env_id, task) for env_id, task, name in HYPERPARAMETERS if name == algo]
+    assert len(tasks) == 3  # the manipulator and both diff-drive tasks
+    for env_id, task in tasks:
         entry = get_hyperparameters(env_id, algo, task)
         sac = get_hyperparameters(env_id, "SAC", task)
         shared = ("train_freq", "gradient_steps", "learning_starts", "batch_size")

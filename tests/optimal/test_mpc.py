@@ -119,7 +119,7 @@ def test_a_plan_slightly_slower_than_h_still_shrinks(short_reference) -> None:  
     # intervals 0.7 % longer than h: rounding alone gives 97 again, the next switch never nears
     assert round(96 * 1.007) == 97
     assert controller._horizon_after_step(plan(97, 1.007 * h)) == 96
-    # a plan that has grown by more than a step is re-gridded to steps of h
+    # intervals more than REGRID_TOLERANCE off h: re-gridded to steps of h
     assert controller._horizon_after_step(plan(20, 1.4 * h)) == 27  # 19 x 1.4 = 26.6
     assert controller._horizon_after_step(plan(20, 0.6 * h)) == 11  # 19 x 0.6 = 11.4
     assert controller._horizon_after_step(plan(1, h)) == 1  # held at min_horizon
