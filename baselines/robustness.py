@@ -17,8 +17,9 @@ with the per-seed rates) and, over the successes, the time and effort ratios to 
 ``robustness_ENV_TASK.json``, ``.png`` (success against the perturbation scale, one curve per
 controller; success under each mismatch) and ``robustness.md`` (the table of every
 ``robustness_*.json`` in the output folder). ``--controllers LABEL ... [--scales ...]
-[--no-mismatch]`` plays only those and merges their results into the study in the folder
-(``merge_studies``), so a slow controller's conditions can be run one at a time.
+[--no-mismatch | --mismatches LABEL ...]`` plays only those and merges their results into the
+study in the folder (``merge_studies``), so a slow controller's conditions can be run one at a
+time (``--scales`` with no value plays no perturbation scale).
 """
 
 from __future__ import annotations
@@ -103,12 +104,13 @@ def controllers_for(env_id: str, task: str, mpc: bool = False,
 def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                scales: Sequence[float] = SCALES, trained_dir: Path = TRAINED_DIR,
                log: Callable[[str], None] | None = None,
-               mismatches: bool = True, only: Sequence[str] | None = None) -> dict[str, Any]:
+               mismatches: bool | Sequence[str] = True,
+               only: Sequence[str] | None = None) -> dict[str, Any]:
     """Play every controller under every condition (see the module docstring).
 
-    ``mismatches=False`` plays the perturbation scales only; ``only`` names the controllers
-    to play (labels, e.g. "PPO"; None: all), for a study completed piece by piece
-    (``merge_studies``).
+    ``mismatches=False`` plays the perturbation scales only, a sequence of labels (of
+    ``MISMATCHES[env_id]``) only those mismatches; ``only`` names the controllers to play
+    (labels, e.g. "PPO"; None: all), for a study completed piece by piece (``merge_studies``).
 
     Returns:
         {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort", "seeds",
@@ -123,9 +125,16 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
     optimal_time, optimal_effort = reference.final_time, reference_effort(reference)
     conditions = [{"label": f"perturbation {scale:g}", "scale": float(scale), "mismatch": None}
                   for scale in scales]
-    conditions += [{"label": label, "scale": DEFAULT_SCALE, "mismatch": label}
-                   for label, _ in MISMATCHES[env_id] if mismatches]
     factories = dict(MISMATCHES[env_id])
+    if isinstance(mismatches, bool):
+        mismatch_labels = list(factories) if mismatches else []
+    else:
+        mismatch_labels = list(mismatches)
+        unknown = [label for label in mismatch_labels if label not in factories]
+        if unknown:
+            raise ValueError(f"unknown mismatch {unknown} for {env_id}; known: {list(factories)}")
+    conditions += [{"label": label, "scale": DEFAULT_SCALE, "mismatch": label}
+                   for label in factories if label in mismatch_labels]
     available = controllers_for(env_id, task, mpc, trained_dir)
     require_known_labels(only, [label for label, _ in available], env_id, task)
     rows = []
@@ -251,10 +260,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("env_id", choices=[MANIPULATOR, DIFF_DRIVE, "all"])
     parser.add_argument("--task", choices=("time", "effort"), default=None)
     parser.add_argument("--seeds", type=int, default=20, help="perturbed starts per run")
-    parser.add_argument("--scales", type=float, nargs="+", default=list(SCALES))
+    parser.add_argument("--scales", type=float, nargs="*", default=list(SCALES),
+                        help="start perturbation scales (none: play no scale)")
     parser.add_argument("--mpc", action="store_true", help="include the MPC (needs CasADi)")
     parser.add_argument("--mismatch", action=argparse.BooleanOptionalAction, default=True,
                         help="also play the model mismatches (default: yes)")
+    parser.add_argument("--mismatches", nargs="+", default=None, metavar="LABEL",
+                        help="play only these model mismatches (labels as in the table)")
     parser.add_argument("--controllers", nargs="+", default=None, metavar="LABEL",
                         help="play only these controllers (labels as in the table) and merge "
                         "their results into the study already in --output")
@@ -270,7 +282,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     for env_id, task in jobs:
         study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
                            log=lambda line: print(line, file=sys.stderr, flush=True),
-                           mismatches=args.mismatch, only=args.controllers)
+                           mismatches=(args.mismatches if args.mismatch and args.mismatches
+                                       else args.mismatch),
+                           only=args.controllers)
         stem = f"robustness_{env_id.split('/')[-1]}_{task}"
         args.output.mkdir(parents=True, exist_ok=True)
         path = args.output / f"{stem}.json"

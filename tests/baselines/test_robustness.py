@@ -65,8 +65,21 @@ def test_a_controller_rerun_merges_into_the_study(tmp_path: Path) -> None:
     (row,) = study["controllers"]
     assert [r["condition"] for r in row["results"]] == ["perturbation 0.01", "perturbation 0.3"]
     assert row["results"][1]["success_rate"] == 0.0  # the open loop at 0.3 (as above)
+    # one mismatch alone, no perturbation scale: merged after the scales
+    assert main([ROBOT, "--task", "effort", "--seeds", "1", "--trained", str(tmp_path),
+                 "--output", str(out), "--scales", "--mismatches", "friction +20 %",
+                 "--controllers", "optimal (open loop)"]) == 0
+    study = json.loads((out / "robustness_DiffDriveRobot-v0_effort.json").read_text())
+    assert [c["label"] for c in study["conditions"]] == ["perturbation 0.01", "perturbation 0.3",
+                                                         "friction +20 %"]
     with pytest.raises(ValueError, match="seeds"):
         merge_studies(study, {**study, "seeds": 2})
+
+
+def test_an_unknown_mismatch_label_is_an_error(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=r"unknown mismatch \['mass \+20 %'\]"):
+        robustness(ROBOT, "effort", num_seeds=1, scales=(), trained_dir=tmp_path,
+                   mismatches=["mass +20 %"])
 
 
 def test_an_unknown_controller_label_is_an_error(tmp_path: Path) -> None:
