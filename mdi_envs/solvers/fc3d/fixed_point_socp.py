@@ -1,0 +1,142 @@
+"""De Saxce's fixed point over convex second-order-cone QPs (``fixed_point_socp``).
+
+For a fixed shift s (nc,) of the normal velocities and a fixed v (3 nc,), the cone
+complementarity problem
+
+    K_mu contains r  _|_  W_s r + q + v + s e_N  in K_mu*,      W_s = (W + W^T) / 2,
+
+is the KKT system of the convex QP ``min 1/2 r^T W_s r + (q + v + s e_N)^T r, r in K_mu``
+(``cone_qp.ConeQP``, solved by the Clarabel interior-point method; W_s positive semidefinite,
+possibly singular). With s = mu ||u_T|| and v = W_a r (W_a = (W - W^T) / 2, u = W r + q), its
+solutions are exactly those of FC3D (De Saxce's modified velocity ``u_hat = u + mu ||u_T|| e_N``).
+The method iterates the map (s, v) -> (mu ||u_T(r)||, W_a r) of the QP minimiser r, relaxed by
+``relaxation``: the Panagiotopoulos / De Saxce fixed point on the convex relaxation (Acary,
+Cadoux, Lemarechal & Malick 2011), with the non-symmetric part of W carried as a data term.
+
+Where the null spaces of W_s and W coincide (W = H M^-1 H^T, as in every Siconos peer problem),
+W r and W_a r are the same for every QP minimiser, so the map is well defined although r is not
+unique where W is rank deficient. Convergence of the fixed point is not guaranteed (it is known
+for small mu); each step costs one interior-point solve. The best iterate (by the shared
+residual) is kept, and the iteration stops after ``max_iter`` steps or once ``stall_iter``
+steps in a row failed to bring the best residual below 0.9 times its value at the last such
+improvement. If the best residual is then below ``polish_below`` (but above ``tol``), up to
+``polish_iter`` steps of ``newton_ac`` start from it, and the better of the two is returned.
+CONVERGED: shared residual <= tol; MAX_ITER: budget spent; BREAKDOWN: a QP had no minimiser.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mdi_envs._types import FloatArray
+from mdi_envs.solvers._registry import (
+    SolverOptions,
+    require_integer_option,
+    require_real_option,
+)
+from mdi_envs.solvers.fc3d.cone_qp import ConeQP
+from mdi_envs.solvers.fc3d.newton_ac import NewtonACOptions, solve_newton_ac
+from mdi_envs.solvers.fc3d.problem import FrictionContact3D, natural_map
+from mdi_envs.solvers.fc3d.registry import FC3D_METHODS
+from mdi_envs.solvers.status import SolverStatus
+
+
+@dataclass(frozen=True)
+class FixedPointSOCPOptions(SolverOptions):
+    """Options of the fixed point over cone QPs.
+
+    Attributes:
+        max_iter: fixed-point steps (one interior-point solve each).
+        relaxation: omega in (0, 1]: (s, v) <- (s, v) + omega (map(s, v) - (s, v)).
+        socp_tol: Clarabel's gap and feasibility tolerances for each QP, > 0.
+        socp_max_iter: Clarabel's iteration limit per QP.
+        stall_iter: steps without a 10 % improvement of the best residual that end the
+            fixed point.
+        polish_below: shared residual under which ``newton_ac`` polishes the best iterate
+            (0: never polish).
+        polish_iter: Newton step limit of the polish.
+    """
+
+    max_iter: int = 300
+    relaxation: float = 0.5
+    socp_tol: float = 1e-10
+    socp_max_iter: int = 200
+    stall_iter: int = 50
+    polish_below: float = 1e-4
+    polish_iter: int = 100
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        require_real_option(self, "relaxation", low=0.0, high=1.0, low_inclusive=False)
+        require_real_option(self, "socp_tol", low=0.0, low_inclusive=False)
+        require_integer_option(self, "socp_max_iter", minimum=1)
+        require_integer_option(self, "stall_iter", minimum=1)
+        require_real_option(self, "polish_below", low=0.0)
+        require_integer_option(self, "polish_iter", minimum=1)
+
+
+def _polish(
+    problem: FrictionContact3D, r: FloatArray, options: FixedPointSOCPOptions
+) -> tuple[FloatArray, int]:
+    """``newton_ac`` from r; returns (its iterate, its steps)."""
+    newton = NewtonACOptions(tol=options.tol, max_iter=options.polish_iter)
+    r_new, _, steps = solve_newton_ac(problem, r, newton)
+    return r_new, steps
+
+
+@FC3D_METHODS.register(
+    "fixed_point_socp", FixedPointSOCPOptions,
+    "De Saxce fixed point on convex cone QPs (Clarabel), newton_ac polish; needs clarabel",
+)
+def solve_fixed_point_socp(
+    problem: FrictionContact3D, r0: FloatArray | None, options: FixedPointSOCPOptions
+) -> tuple[FloatArray, SolverStatus, int]:
+    """Solve ``problem``; returns (r, status, fixed-point steps + polish steps).
+
+    The fixed point starts from s = mu ||u_T(r0)||, v = W_a r0 (r0 = 0 by default).
+
+    Raises:
+        ImportError: clarabel is not installed (the message names the ``conic`` extra).
+    """
+    W, q, mu = problem.W, problem.q, problem.mu
+    n = q.shape[0]
+    W_a = 0.5 * (W - W.T)
+    qp = ConeQP(0.5 * (W + W.T), mu, options.socp_tol, options.socp_max_iter)
+    tol, omega = float(options.tol), float(options.relaxation)
+    r = np.zeros(n) if r0 is None else r0.copy()
+    u = np.empty(n)
+    natural_map(W, q, mu, r, u)
+    s, v = mu * np.hypot(u[1::3], u[2::3]), W_a @ r
+    best_r, best, mark, last_progress = r, np.inf, np.inf, 0
+    steps = 0
+    for steps in range(1, int(options.max_iter) + 1):
+        c = q + v
+        c[0::3] += s
+        r_qp = qp.solve(c)
+        if r_qp is None:
+            return best_r, SolverStatus.BREAKDOWN, steps
+        residual = natural_map(W, q, mu, r_qp, u)
+        if residual <= tol:
+            return r_qp, SolverStatus.CONVERGED, steps
+        if residual < best:
+            best_r, best = r_qp, residual
+        if residual < 0.9 * mark:
+            mark, last_progress = residual, steps
+        elif steps - last_progress >= options.stall_iter:
+            break
+        s += omega * (mu * np.hypot(u[1::3], u[2::3]) - s)
+        v += omega * (W_a @ r_qp - v)
+    if best <= options.polish_below:
+        r_polish, polish_steps = _polish(problem, best_r, options)
+        steps += polish_steps
+        polished = natural_map(W, q, mu, r_polish, u)
+        if polished <= tol:
+            return r_polish, SolverStatus.CONVERGED, steps
+        if polished < best:
+            best_r = r_polish
+    return best_r, SolverStatus.MAX_ITER, steps
+
+
+__all__ = ["FixedPointSOCPOptions", "solve_fixed_point_socp"]
