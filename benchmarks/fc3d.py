@@ -6,8 +6,10 @@ Usage (from the repository root)::
     python -m benchmarks.fc3d --output /tmp/fc3d --quick           # problems with n <= 150
 
 Runs ``solve_fc3d`` with ``newton_ac`` and ``nsgs`` (the methods before issue 23: the previous
-numbers) and ``hybrid`` (sparse Newton with a Levenberg shift chained with NSGS sweeps) on each
-``fc3d/*.dat`` file of the peer data, from r = 0. Each result's residual is recomputed with
+numbers), ``hybrid`` (sparse Newton with a Levenberg shift chained with NSGS sweeps) and
+``fixed_point_socp`` (De Saxce's fixed point on convex cone QPs solved by Clarabel, with a
+``newton_ac`` polish; needs the ``conic`` extra) on each ``fc3d/*.dat`` file of the peer data,
+from r = 0. Each result's residual is recomputed with
 ``fc3d_residual``; a problem counts as solved when some method reports CONVERGED (residual
 <= 1e-8). A call shorter than 20 ms is repeated and its median time kept. Writes ``fc3d.json``
 and ``fc3d.png`` (time and residual per problem and method) and prints the Markdown table.
@@ -38,6 +40,7 @@ METHODS: dict[str, dict[str, Any]] = {
     "newton_ac": {"max_iter": 100},
     "nsgs": {"max_iter": 2000},
     "hybrid": {"max_iter": 500},
+    "fixed_point_socp": {"max_iter": 300},
 }
 """Method -> options of the run (budgets: Newton steps or sweeps)."""
 
@@ -139,13 +142,14 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
     names = [f"{r['name']} (n={r['n']})" for r in rows]
     y = np.arange(len(rows))
     fig, (ax_t, ax_r) = plt.subplots(1, 2, figsize=(13, 0.25 * len(rows) + 2), sharey=True)
+    width = 0.8 / len(METHODS)
     for k, method in enumerate(METHODS):
-        offset = (k - 1) * 0.27
+        offset = (k - (len(METHODS) - 1) / 2) * width
         times = [r[method]["time_s"] for r in rows]
         residuals = [max(r[method]["residual"], 1e-18) for r in rows]
         colors = [f"C{k}" if r[method]["converged"] else "lightgrey" for r in rows]
-        ax_t.barh(y + offset, times, 0.27, color=colors, edgecolor=f"C{k}", label=method)
-        ax_r.barh(y + offset, residuals, 0.27, color=colors, edgecolor=f"C{k}", label=method)
+        ax_t.barh(y + offset, times, width, color=colors, edgecolor=f"C{k}", label=method)
+        ax_r.barh(y + offset, residuals, width, color=colors, edgecolor=f"C{k}", label=method)
     ax_r.axvline(TOL, color="k", lw=0.8, ls=":")
     for ax, label in ((ax_t, "time per solve (s)"), (ax_r, "residual (0 drawn at 1e-18)")):
         ax.set_xscale("log")

@@ -35,8 +35,10 @@ def solve_fc3d(
         q: (3 nc,) free velocity.
         mu: (nc,) friction coefficients, >= 0.
         method: one of ``FC3D_METHODS.names()``: ``"newton_ac"`` (global semismooth Newton on
-            the Alart-Curnier function; the default) or ``"nsgs"`` (non-smooth block
-            Gauss-Seidel over the contacts).
+            the Alart-Curnier function; the default), ``"nsgs"`` (non-smooth block
+            Gauss-Seidel over the contacts), ``"hybrid"`` (sparse shifted Newton chained with
+            NSGS) or ``"fixed_point_socp"`` (De Saxce's fixed point on convex cone QPs; needs
+            clarabel, the ``conic`` extra).
         r0: (3 nc,) starting point (warm start; default 0). Unused when every q_N >= 0: then
             r = 0 is returned at once, as an exact solution.
         **options: fields of the method's options dataclass (``tol``, ``max_iter``, ...).
@@ -46,6 +48,7 @@ def solve_fc3d(
 
     Raises:
         ValueError: NaN/inf or mis-shaped data, mu < 0, an unknown method or option.
+        ImportError: ``"fixed_point_socp"`` without clarabel installed.
 
     Example:
         One contact, W = I, pressed down (q_N = -1) and pushed sideways hard enough to slide

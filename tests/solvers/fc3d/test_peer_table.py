@@ -3,8 +3,9 @@
 One method per problem: ``newton_ac`` where it converges, ``hybrid`` where it is the one that
 does (``Capsules-i122-1617``) or is faster (the largest problems); the times are those of
 ``python -m benchmarks.fc3d`` (benchmarks/results/fc3d.json), the whole table about 10 s.
-``RockPile_tob1`` is the one no method solves (best: NSGS 8e-6 after about 11 000 sweeps,
-then it drifts): an expected failure with a short budget, strict so that a fix shows up.
+``RockPile_tob1`` is the one no method solves (best: ``fixed_point_socp`` about 4e-6, see
+``test_fixed_point_socp``; NSGS 8e-6 after about 11 000 sweeps, then it drifts): an expected
+failure with a short budget, strict so that a fix shows up.
 Skips cleanly when ../shared is absent.
 """
 
@@ -33,7 +34,8 @@ def _params() -> list[object]:
         if path is not None and path.stem == UNSOLVED:
             param = pytest.param(path, id=path.stem, marks=pytest.mark.xfail(
                 strict=True, reason="no method reaches 1e-8 (newton_ac 5.8e-4, nsgs 5e-5 "
-                "after 2000 sweeps, hybrid 9e-4): the issue-23 target missed on this file"))
+                "after 2000 sweeps, hybrid 9e-4, fixed_point_socp 4e-6): the issue-23 target "
+                "missed on this file"))
         params.append(param)
     return params
 
