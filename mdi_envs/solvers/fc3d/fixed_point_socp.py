@@ -19,8 +19,10 @@ unique where W is rank deficient. Convergence of the fixed point is not guarante
 for small mu); each step costs one interior-point solve. The best iterate (by the shared
 residual) is kept, and the iteration stops after ``max_iter`` steps or once ``stall_iter``
 steps in a row failed to bring the best residual below 0.9 times its value at the last such
-improvement. If the best residual is then below ``polish_below`` (but above ``tol``), up to
-``polish_iter`` steps of ``newton_ac`` start from it, and the better of the two is returned.
+improvement. The first iterate whose residual is at most ``polish_below`` (but above ``tol``)
+is polished once by up to ``polish_iter`` steps of ``newton_ac`` (locally quadratic where the
+fixed point is only linear); if that does not converge the fixed point goes on, and the best
+iterate of either is returned. A starting point r0 that already meets ``tol`` is returned as is.
 CONVERGED: shared residual <= tol; MAX_ITER: budget spent; BREAKDOWN: a QP had no minimiser.
 """
 
@@ -54,7 +56,7 @@ class FixedPointSOCPOptions(SolverOptions):
         socp_max_iter: Clarabel's iteration limit per QP.
         stall_iter: steps without a 10 % improvement of the best residual that end the
             fixed point.
-        polish_below: shared residual under which ``newton_ac`` polishes the best iterate
+        polish_below: shared residual at which ``newton_ac`` polishes the iterate, once
             (0: never polish).
         polish_iter: Newton step limit of the polish.
     """
@@ -64,8 +66,8 @@ class FixedPointSOCPOptions(SolverOptions):
     socp_tol: float = 1e-10
     socp_max_iter: int = 200
     stall_iter: int = 50
-    polish_below: float = 1e-4
-    polish_iter: int = 100
+    polish_below: float = 1e-6
+    polish_iter: int = 50
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -107,36 +109,37 @@ def solve_fixed_point_socp(
     tol, omega = float(options.tol), float(options.relaxation)
     r = np.zeros(n) if r0 is None else r0.copy()
     u = np.empty(n)
-    natural_map(W, q, mu, r, u)
+    if natural_map(W, q, mu, r, u) <= tol:
+        return r, SolverStatus.CONVERGED, 0
     s, v = mu * np.hypot(u[1::3], u[2::3]), W_a @ r
     best_r, best, mark, last_progress = r, np.inf, np.inf, 0
-    steps = 0
+    is_polished, polish_steps, steps = False, 0, 0
     for steps in range(1, int(options.max_iter) + 1):
         c = q + v
         c[0::3] += s
         r_qp = qp.solve(c)
         if r_qp is None:
-            return best_r, SolverStatus.BREAKDOWN, steps
+            return best_r, SolverStatus.BREAKDOWN, steps + polish_steps
         residual = natural_map(W, q, mu, r_qp, u)
         if residual <= tol:
-            return r_qp, SolverStatus.CONVERGED, steps
+            return r_qp, SolverStatus.CONVERGED, steps + polish_steps
         if residual < best:
             best_r, best = r_qp, residual
+        if not is_polished and residual <= options.polish_below:
+            is_polished = True
+            r_polish, polish_steps = _polish(problem, r_qp, options)
+            polished = problem.residual(r_polish)
+            if polished <= tol:
+                return r_polish, SolverStatus.CONVERGED, steps + polish_steps
+            if polished < best:
+                best_r, best = r_polish, polished
+            natural_map(W, q, mu, r_qp, u)  # u of the fixed-point iterate again
         if residual < 0.9 * mark:
             mark, last_progress = residual, steps
         elif steps - last_progress >= options.stall_iter:
             break
         s += omega * (mu * np.hypot(u[1::3], u[2::3]) - s)
         v += omega * (W_a @ r_qp - v)
-    if best <= options.polish_below:
-        r_polish, polish_steps = _polish(problem, best_r, options)
-        steps += polish_steps
-        polished = natural_map(W, q, mu, r_polish, u)
-        if polished <= tol:
-            return r_polish, SolverStatus.CONVERGED, steps
-        if polished < best:
-            best_r = r_polish
-    return best_r, SolverStatus.MAX_ITER, steps
-
+    return best_r, SolverStatus.MAX_ITER, steps + polish_steps
 
 __all__ = ["FixedPointSOCPOptions", "solve_fixed_point_socp"]

@@ -21,7 +21,7 @@ METHODS = FC3D_METHODS.names()
 
 
 def test_all_methods_are_registered() -> None:
-    assert METHODS == ["hybrid", "newton_ac", "nsgs"]
+    assert METHODS == ["fixed_point_socp", "hybrid", "newton_ac", "nsgs"]
     assert set(FC3D_METHODS.summaries()) == set(METHODS)
 
 
