@@ -21,8 +21,9 @@ residual) is kept, and the iteration stops after ``max_iter`` steps or once ``st
 steps in a row failed to bring the best residual below 0.9 times its value at the last such
 improvement. The first iterate whose residual is at most ``polish_below`` (but above ``tol``)
 is polished once by up to ``polish_iter`` steps of ``newton_ac`` (locally quadratic where the
-fixed point is only linear); if that does not converge the fixed point goes on, and the best
-iterate of either is returned. A starting point r0 that already meets ``tol`` is returned as is.
+fixed point is only linear); if that does not converge the fixed point goes on. When it stops
+without such a polish, the best iterate gets it. The best iterate of all is returned. A starting
+point r0 that already meets ``tol`` is returned as is.
 CONVERGED: shared residual <= tol; MAX_ITER: budget spent; BREAKDOWN: a QP had no minimiser.
 """
 
@@ -140,6 +141,13 @@ def solve_fixed_point_socp(
             break
         s += omega * (mu * np.hypot(u[1::3], u[2::3]) - s)
         v += omega * (W_a @ r_qp - v)
+    if not is_polished and options.polish_below > 0.0:
+        r_polish, polish_steps = _polish(problem, best_r, options)
+        polished = problem.residual(r_polish)
+        if polished <= tol:
+            return r_polish, SolverStatus.CONVERGED, steps + polish_steps
+        if polished < best:
+            best_r = r_polish
     return best_r, SolverStatus.MAX_ITER, steps + polish_steps
 
 __all__ = ["FixedPointSOCPOptions", "solve_fixed_point_socp"]
