@@ -36,12 +36,12 @@ def test_every_entry_fixes_the_shaping_discount_and_lookups_copy() -> None:
         expected = 0.99 if key == ("mdi_envs/BlockableManipulator-v0", "time", "PPO") else 1.0
         assert entry["env_kwargs"]["shaping_discount"] == expected, key
     entry = get_hyperparameters("mdi_envs/DiffDriveRobot-v0", "sac", "effort")
-    assert entry["env_kwargs"] == {"task": "effort", "goal_weight": 100.0,
+    assert entry["env_kwargs"] == {"task": "effort", "goal_weight": 1000.0,
                                    "shaping_discount": 1.0}  # fmt: skip
     entry["algo_kwargs"]["gamma"] = 0.5
     entry["env_kwargs"]["goal_weight"] = 1.0
     fresh = get_hyperparameters("mdi_envs/DiffDriveRobot-v0", "SAC", "effort")
-    assert fresh["algo_kwargs"]["gamma"] == 0.99 and fresh["env_kwargs"]["goal_weight"] == 100.0
+    assert fresh["algo_kwargs"]["gamma"] == 0.99 and fresh["env_kwargs"]["goal_weight"] == 1000.0
     with pytest.raises(KeyError, match="known"):
         get_hyperparameters("mdi_envs/BlockableManipulator-v0", "PPO", "effort")
 
@@ -100,19 +100,22 @@ def test_shipped_policies_were_trained_with_the_table() -> None:
 
 
 @pytest.mark.parametrize("algo", ["TQC", "CrossQ"])
-def test_the_off_policy_probes_share_sacs_budget_with_normalized_rewards(algo: str) -> None:
-    """TQC and CrossQ: SAC's copies, budget and replay ratio, and PPO's effort reward."""
+def test_the_off_policy_algorithms_share_sacs_settings(algo: str) -> None:
+    """TQC and CrossQ: SAC's copies, budget, replay ratio, n-step returns and rewards."""
     tasks = [(env_id, task) for env_id, task, name in HYPERPARAMETERS if name == algo]
     assert len(tasks) == 3  # the manipulator and both diff-drive tasks
     for env_id, task in tasks:
         entry = get_hyperparameters(env_id, algo, task)
         sac = get_hyperparameters(env_id, "SAC", task)
-        shared = ("train_freq", "gradient_steps", "learning_starts", "batch_size")
+        shared = ("train_freq", "gradient_steps", "learning_starts", "batch_size", "n_steps",
+                  "gamma", "buffer_size", "ent_coef")
         assert (entry["num_envs"], entry["total_timesteps"]) == (sac["num_envs"],
                                                                  sac["total_timesteps"])
         assert [entry["algo_kwargs"][key] for key in shared] == [sac["algo_kwargs"][key]
                                                                  for key in shared]
-        assert entry["normalize_reward"]
-        if task == "effort":
+        assert sac["algo_kwargs"]["n_steps"] == 10
+        assert entry["env_kwargs"] == sac["env_kwargs"]
+        assert entry["normalize_reward"] == sac["normalize_reward"] == (task == "effort")
+        if task == "effort":  # PPO's effort reward
             ppo = get_hyperparameters(env_id, "PPO", task)
             assert entry["env_kwargs"] == ppo["env_kwargs"]
