@@ -20,10 +20,16 @@ for small mu); each step costs one interior-point solve. The best iterate (by th
 residual) is kept, and the iteration stops after ``max_iter`` steps or once ``stall_iter``
 steps in a row failed to bring the best residual below 0.9 times its value at the last such
 improvement. The first iterate whose residual is at most ``polish_below`` (but above ``tol``)
-is polished once by up to ``polish_iter`` steps of ``newton_ac`` (locally quadratic where the
-fixed point is only linear); if that does not converge the fixed point goes on. When it stops
-without such a polish, the best iterate gets it. The best iterate of all is returned. A starting
-point r0 that already meets ``tol`` is returned as is.
+is polished (below); if that does not converge the fixed point goes on. When it stops without
+such a polish, the best iterate gets it. The best iterate of all is returned. A starting point
+r0 that already meets ``tol`` is returned as is.
+
+The polish is up to ``polish_cycles`` rounds of: at most ``polish_iter`` steps of the sparse
+shifted Newton method of ``hybrid`` without NSGS sweeps (locally quadratic where the fixed
+point is only linear), then, if that did not converge, ``unload_duplicates``
+(``duplicate_contacts.py``): of each pair of loaded contacts with the same normal row of W,
+the one with the higher normal velocity hands its impulse to the other. That regime change is
+what the fixed point and Newton cannot do themselves on ``RockPile_tob1`` (74 such pairs).
 CONVERGED: shared residual <= tol; MAX_ITER: budget spent; BREAKDOWN: a QP had no minimiser.
 """
 
@@ -40,7 +46,8 @@ from mdi_envs.solvers._registry import (
     require_real_option,
 )
 from mdi_envs.solvers.fc3d.cone_qp import ConeQP
-from mdi_envs.solvers.fc3d.newton_ac import NewtonACOptions, solve_newton_ac
+from mdi_envs.solvers.fc3d.duplicate_contacts import duplicate_normal_pairs, unload_duplicates
+from mdi_envs.solvers.fc3d.hybrid import HybridOptions, solve_hybrid
 from mdi_envs.solvers.fc3d.problem import FrictionContact3D, natural_map
 from mdi_envs.solvers.fc3d.registry import FC3D_METHODS
 from mdi_envs.solvers.status import SolverStatus
@@ -57,9 +64,9 @@ class FixedPointSOCPOptions(SolverOptions):
         socp_max_iter: Clarabel's iteration limit per QP.
         stall_iter: steps without a 10 % improvement of the best residual that end the
             fixed point.
-        polish_below: shared residual at which ``newton_ac`` polishes the iterate, once
-            (0: never polish).
-        polish_iter: Newton step limit of the polish.
+        polish_below: shared residual at which the polish starts, once (0: never polish).
+        polish_iter: Newton step limit of each polishing round.
+        polish_cycles: polishing rounds (Newton, then unloading duplicate contacts).
     """
 
     max_iter: int = 300
@@ -68,7 +75,8 @@ class FixedPointSOCPOptions(SolverOptions):
     socp_max_iter: int = 200
     stall_iter: int = 50
     polish_below: float = 1e-6
-    polish_iter: int = 50
+    polish_iter: int = 1000
+    polish_cycles: int = 5
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -78,20 +86,37 @@ class FixedPointSOCPOptions(SolverOptions):
         require_integer_option(self, "stall_iter", minimum=1)
         require_real_option(self, "polish_below", low=0.0)
         require_integer_option(self, "polish_iter", minimum=1)
+        require_integer_option(self, "polish_cycles", minimum=1)
 
 
 def _polish(
     problem: FrictionContact3D, r: FloatArray, options: FixedPointSOCPOptions
-) -> tuple[FloatArray, int]:
-    """``newton_ac`` from r; returns (its iterate, its steps)."""
-    newton = NewtonACOptions(tol=options.tol, max_iter=options.polish_iter)
-    r_new, _, steps = solve_newton_ac(problem, r, newton)
-    return r_new, steps
+) -> tuple[FloatArray, float, int]:
+    """Newton rounds alternating with ``unload_duplicates`` from r.
+
+    Returns:
+        (the best iterate, its shared residual, the Newton steps taken).
+    """
+    newton = HybridOptions(tol=options.tol, max_iter=options.polish_iter, warm_sweeps=0)
+    pairs = duplicate_normal_pairs(problem.W)
+    best_r, best, steps = r, problem.residual(r), 0
+    for _ in range(int(options.polish_cycles)):
+        r, status, taken = solve_hybrid(problem, r, newton)
+        steps += taken
+        residual = problem.residual(r)
+        if residual < best:
+            best_r, best = r, residual
+        if status is SolverStatus.CONVERGED:
+            break
+        r, moved = unload_duplicates(problem.W, problem.q, r, pairs)
+        if moved == 0:
+            break
+    return best_r, best, steps
 
 
 @FC3D_METHODS.register(
     "fixed_point_socp", FixedPointSOCPOptions,
-    "De Saxce fixed point on convex cone QPs (Clarabel), newton_ac polish; needs clarabel",
+    "De Saxce fixed point on convex cone QPs (Clarabel), Newton polish; needs clarabel",
 )
 def solve_fixed_point_socp(
     problem: FrictionContact3D, r0: FloatArray | None, options: FixedPointSOCPOptions
@@ -128,8 +153,7 @@ def solve_fixed_point_socp(
             best_r, best = r_qp, residual
         if not is_polished and residual <= options.polish_below:
             is_polished = True
-            r_polish, polish_steps = _polish(problem, r_qp, options)
-            polished = problem.residual(r_polish)
+            r_polish, polished, polish_steps = _polish(problem, r_qp, options)
             if polished <= tol:
                 return r_polish, SolverStatus.CONVERGED, steps + polish_steps
             if polished < best:
@@ -142,8 +166,7 @@ def solve_fixed_point_socp(
         s += omega * (mu * np.hypot(u[1::3], u[2::3]) - s)
         v += omega * (W_a @ r_qp - v)
     if not is_polished and options.polish_below > 0.0:
-        r_polish, polish_steps = _polish(problem, best_r, options)
-        polished = problem.residual(r_polish)
+        r_polish, polished, polish_steps = _polish(problem, best_r, options)
         if polished <= tol:
             return r_polish, SolverStatus.CONVERGED, steps + polish_steps
         if polished < best:
