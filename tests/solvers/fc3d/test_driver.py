@@ -205,8 +205,9 @@ def test_larger_peer_problems_are_reported_honestly(method, path, recompute_resi
     max_iter = 300 if method == "nsgs" else 100
     tol = 1e-8
     result = solve_fc3d(data.W, data.q, data.mu, method=method, tol=tol, max_iter=max_iter)
+    # abs: the two sums W r + q round differently (4e-14 apart at a 5e-13 residual, seen)
     assert result.residual == pytest.approx(
-        recompute_residual(data.W, data.q, data.mu, result.r), rel=1e-6, abs=1e-14
+        recompute_residual(data.W, data.q, data.mu, result.r), rel=1e-6, abs=1e-12
     )
     np.testing.assert_allclose(result.u, data.W @ result.r + data.q, rtol=1e-10, atol=1e-10)
     assert (result.status is SolverStatus.CONVERGED) == (result.residual <= tol)
