@@ -339,11 +339,14 @@ class Transcription:
         repeat a sticking row of another contact (the two wheels' lateral slip) stated once;
         sliding fixes the cone slack to 0 and keeps mu P_N xi_T + lam P_T = 0.
         """
-        contact_slip = np.asarray(values(self.outputs["slip_speed"]), dtype=float)
-        cone = np.asarray(values(self._contact.cone_slack), dtype=float)
+        def rows(expression: Any) -> np.ndarray:  # (contacts, N): CasADi drops unit dimensions
+            return np.asarray(values(expression), dtype=float).reshape(expression.shape)
+
+        contact_slip = rows(self.outputs["slip_speed"])
+        cone = rows(self._contact.cone_slack)
         pr = self.problem
         sliding = contact_slip / pr.velocity_scale > cone / pr.impulse_scale**2
-        return Transcription(pr, modes=ModePattern(sliding=np.atleast_2d(sliding)))
+        return Transcription(pr, modes=ModePattern(sliding=sliding))
 
     def set_start(self, q: Any, u: Any) -> None:
         """The initial state of a ``parametric_start`` NLP: q (n,), u (n,) [SI units]."""

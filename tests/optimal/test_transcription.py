@@ -76,11 +76,17 @@ def test_robot_lateral_wheel_rows_are_found_identical() -> None:
     np.testing.assert_array_equal(same, expected)
 
 
-def test_robot_polish_nlp_has_the_same_variables() -> None:
-    """``polished`` rebuilds the NLP with fixed modes but the same variable layout."""
-    transcription = Transcription(make_problem("diff_drive_time", 6))
+@pytest.mark.parametrize("num_intervals", [6, 1])
+def test_robot_polish_nlp_has_the_same_variables(num_intervals: int) -> None:
+    """``polished`` rebuilds the NLP with fixed modes but the same variable layout.
+
+    One interval too: CasADi returns its (3, 1) slip speeds as (3,), which once became a
+    pattern of 3 intervals (the MPC's freed fallback crashed on a one-interval robot plan).
+    """
+    transcription = Transcription(make_problem("diff_drive_time", num_intervals))
     transcription.set_naive_guess()
     opti = transcription.opti
     polished = transcription.polished(lambda expression: opti.value(expression, opti.initial()))
     assert polished.opti.nx == transcription.opti.nx
-    assert polished.modes is not None and polished.modes.sliding.shape == (3, 6)
+    assert polished.modes is not None
+    assert polished.modes.sliding.shape == (3, num_intervals)
