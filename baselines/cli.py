@@ -131,6 +131,7 @@ def run_compare(args: argparse.Namespace) -> int:
         collect_tables,
         compare,
         merge_comparisons,
+        shipped_algorithms,
         write_comparison,
     )
 
@@ -160,7 +161,8 @@ def run_compare(args: argparse.Namespace) -> int:
             raise SystemExit(f"compare: {error}") from error
         previous = args.output / f"compare_{env_id.split('/')[-1]}_{task}.json"
         if args.controllers is not None and previous.exists():
-            comparison = merge_comparisons(json.loads(previous.read_text()), comparison)
+            comparison = merge_comparisons(json.loads(previous.read_text()), comparison,
+                                           shipped_algorithms(env_id, task, trained_dir))
         for path in write_comparison(comparison, args.output, trained_dir):
             print(f"wrote {path}", file=sys.stderr)
     table = collect_tables(args.output)

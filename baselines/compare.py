@@ -30,7 +30,7 @@ import importlib
 import json
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -232,6 +232,11 @@ def group_by_algorithm(configs: Sequence[Path]) -> dict[str, list[Path]]:
         config = json.loads(Path(path).read_text())
         groups.setdefault(config["algo"], []).append((int(config["seed"]), Path(path)))
     return {algo: [path for _, path in sorted(runs)] for algo, runs in groups.items()}
+
+
+def shipped_algorithms(env_id: str, task: str, directory: Path = TRAINED_DIR) -> set[str]:
+    """The algorithms with at least one trained policy for (env id, task) in ``directory``."""
+    return set(group_by_algorithm(shipped_policies(env_id, task, directory)))
 
 
 def load_policy(config_path: Path) -> tuple[Controller, dict[str, Any]]:
@@ -463,11 +468,14 @@ def comparison_record(comparison: dict[str, Any]) -> dict[str, Any]:
     return record
 
 
-def merge_comparisons(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
+def merge_comparisons(old: dict[str, Any], new: dict[str, Any],
+                      shipped: Collection[str] | None = None) -> dict[str, Any]:
     """``new``'s rows over ``old``'s (a ``comparison_record``, e.g. the JSON in the output).
 
     Rows with the same label are replaced, the others kept in ``old``'s order and ``new``'s
-    added after them. Both must compare the same env, task, reference (same optimum) and starts.
+    added after them; with ``shipped`` (the algorithms that have trained policies now,
+    ``shipped_algorithms``) a trained row of another algorithm is dropped (its policies were
+    withdrawn). Both must compare the same env, task, reference (same optimum) and starts.
     Kept rows come back as ``Episode`` objects (perturbed episodes without trajectories).
     """
     for key in ("env_id", "task", "reference", "optimal_time", "optimal_effort", "seeds"):
@@ -479,6 +487,8 @@ def merge_comparisons(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any
     for row in old["controllers"]:
         if row["label"] in replaced:
             rows.append(replaced.pop(row["label"]))
+            continue
+        if shipped is not None and row.get("trained") and row["label"] not in shipped:
             continue
         runs = [{**run, "nominal": Episode.from_record(run["nominal"]),
                  "episodes": [Episode.from_record(e) for e in run["episodes"]]}
@@ -535,6 +545,7 @@ __all__ = [
     "Controller", "Episode", "aggregate_runs", "collect_tables", "compare", "comparison_record",
     "evaluate_controller", "group_by_algorithm", "interval_text", "load_policy",
     "markdown_table", "merge_comparisons", "optimal_controller", "play", "reference_controller",
-    "reference_effort", "registered_controllers", "require_known_labels", "shipped_policies",
+    "reference_effort", "registered_controllers", "require_known_labels", "shipped_algorithms",
+    "shipped_policies",
     "summarize", "write_comparison",
 ]

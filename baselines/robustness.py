@@ -28,7 +28,7 @@ import argparse
 import dataclasses
 import json
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -44,9 +44,11 @@ from baselines.compare import (
     reference_effort,
     registered_controllers,
     require_known_labels,
+    shipped_algorithms,
     shipped_policies,
     summarize,
 )
+from baselines.hyperparameters import ALGORITHMS
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulatorParameters
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
 from optimal.references import load_reference
@@ -167,12 +169,15 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
             "seeds": num_seeds, "conditions": conditions, "controllers": rows}
 
 
-def merge_studies(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
+def merge_studies(old: dict[str, Any], new: dict[str, Any],
+                  shipped: Collection[str] | None = None) -> dict[str, Any]:
     """``old`` with the (controller, condition) results of ``new`` added or replaced.
 
     Both must be of the same env, task and number of starts. Conditions keep their order
     (scales ascending, then the mismatches); a controller without a result for some condition
-    shows none there.
+    shows none there. With ``shipped`` (the algorithms that have trained policies now), an
+    old row of another trained algorithm (``ALGORITHMS``) is dropped: its policies were
+    withdrawn.
     """
     for key in ("env_id", "task", "seeds"):
         if old[key] != new[key]:
@@ -183,7 +188,8 @@ def merge_studies(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
     ordered = sorted(conditions.values(), key=lambda c: (
         c["mismatch"] is not None,
         c["scale"] if c["mismatch"] is None else mismatch_order.index(c["mismatch"])))
-    rows = {row["label"]: row for row in old["controllers"]}
+    rows = {row["label"]: row for row in old["controllers"]
+            if shipped is None or row["label"] not in ALGORITHMS or row["label"] in shipped}
     for row in new["controllers"]:
         kept = rows.get(row["label"], {"results": []})["results"]
         by_condition = {r["condition"]: r for r in kept + row["results"]}
@@ -289,7 +295,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args.output.mkdir(parents=True, exist_ok=True)
         path = args.output / f"{stem}.json"
         if args.controllers is not None and path.exists():
-            study = merge_studies(json.loads(path.read_text()), study)
+            study = merge_studies(json.loads(path.read_text()), study,
+                                  shipped_algorithms(env_id, task, args.trained))
         path.write_text(json.dumps(study, indent=1))
         plot_robustness(study, args.output / f"{stem}.png")
     # every study in the folder, so that rerunning one env x task keeps the others' rows

@@ -202,10 +202,13 @@ def test_a_row_rerun_merges_into_the_comparison(tmp_path: Path) -> None:
     first = json.loads(path.read_text())
     nominal = first["controllers"][0]["runs"][0]["nominal"]
     assert len(nominal["trajectory"]["q"]) == nominal["num_steps"] + 1  # kept for merges
-    kept = {**first, "controllers": [{**first["controllers"][0], "label": "kept row"}]}
+    row = first["controllers"][0]
+    withdrawn = {**row, "label": "SAC", "algo": "SAC", "trained": True}  # no SAC in --trained
+    kept = {**first, "controllers": [{**row, "label": "kept row"}, withdrawn]}
     path.write_text(json.dumps(kept))
     assert main([*common, "--controllers", OPTIMAL]) == 0
     merged = json.loads(path.read_text())
+    # the untrained row stays; the trained row whose policies are gone is dropped
     assert [row["label"] for row in merged["controllers"]] == ["kept row", OPTIMAL]
     assert merged["controllers"][0]["runs"] == first["controllers"][0]["runs"]
     assert "| kept row |" in (tmp_path / "compare.md").read_text()

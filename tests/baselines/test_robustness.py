@@ -72,6 +72,13 @@ def test_a_controller_rerun_merges_into_the_study(tmp_path: Path) -> None:
     study = json.loads((out / "robustness_DiffDriveRobot-v0_effort.json").read_text())
     assert [c["label"] for c in study["conditions"]] == ["perturbation 0.01", "perturbation 0.3",
                                                          "friction +20 %"]
+    # a trained algorithm whose policies are gone from --trained leaves the study at a merge
+    withdrawn = {**study["controllers"][0], "label": "SAC"}
+    path = out / "robustness_DiffDriveRobot-v0_effort.json"
+    path.write_text(json.dumps({**study, "controllers": [*study["controllers"], withdrawn]}))
+    assert main([*common, "--scales", "0.3", "--controllers", "optimal (open loop)"]) == 0
+    labels = [row["label"] for row in json.loads(path.read_text())["controllers"]]
+    assert labels == ["optimal (open loop)"]
     with pytest.raises(ValueError, match="seeds"):
         merge_studies(study, {**study, "seeds": 2})
 
