@@ -158,7 +158,6 @@ def solve_fixed_point_socp(
                 return r_polish, SolverStatus.CONVERGED, steps + polish_steps
             if polished < best:
                 best_r, best = r_polish, polished
-            natural_map(W, q, mu, r_qp, u)  # u of the fixed-point iterate again
         if residual < 0.9 * mark:
             mark, last_progress = residual, steps
         elif steps - last_progress >= options.stall_iter:
