@@ -22,10 +22,10 @@ the modes it found), and last the previous plan's next control open loop
 Horizon: one env step is one interval (the env runs at the reference's h, ``env_options``), and
 t_f = N h. A plan of N intervals is followed by one of N - 1 (the env's steps left); a
 time-optimal problem shrinks by a step while the goal stays reachable and takes extra steps
-only where it does not (it never looks for an arrival earlier than planned). An earlier design kept t_f free on N
-equal intervals near h: its plans were not on the env's grid (each interval held for h instead
-of t_f / N; the last ones 11 ms long, held for 35.5 ms, overshot the goal), and the closed loop
-lost 9 % over its first plans (optimal/README.md).
+only where it does not (it never looks for an arrival earlier than planned). An earlier
+design kept t_f free on N equal intervals near h: its plans were not on the env's grid (each
+interval held for h instead of t_f / N; the last ones 11 ms long, held for 35.5 ms, overshot
+the goal), and the closed loop lost 9 % over its first plans (optimal/README.md).
 
 ``ShrinkingHorizonMPC(reference)`` is a policy: ``controller(observation) -> action`` in the
 env's default Box action space (the observation is decoded into (q, u): the manipulator's
@@ -78,8 +78,8 @@ ahead. All neighbours of a robot plan (3 contacts) were 20-27 new NLPs, 30-50 s 
 
 MAX_EXTRA_STEPS = 3
 """A time-optimal re-plan that cannot reach the goal in the env steps left tries arriving 1, 2,
-... this many steps later (the plan stretched over the longer grid as the warm start); longer
-detours are not taken."""
+... this many steps later (warm-started from ``Plan.delayed``); longer detours are not
+taken."""
 
 
 @dataclass(frozen=True, eq=False)
