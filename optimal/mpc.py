@@ -4,9 +4,7 @@ At every env step the controller re-solves the remaining optimal-control problem
 measured state -- the same model definition and midpoint transcription as the references
 (``optimal.transcription``), with the mode pattern (brake schedule, stick-slip) of its previous
 plan fixed (``optimal.mode_search.solve_with_modes``), warm-started from that plan shifted by
-one interval -- and applies the first interval's torque and brake command. Every plan is on the
-env's grid: N intervals of exactly the env step h, so the control applied is held for as long
-as planned and the plan arrives at the end of an env step. Each NLP is built
+one interval -- and applies the first interval's torque and brake command. Each NLP is built
 once per (intervals, pattern, goal relaxed) with the start as a parameter
 (``Transcription(parametric_start=True)``) and kept (``NLP_CACHE_SIZE``): building costs more
 than a warm-started solve, and episodes from nearby starts revisit the same keys. Where the
@@ -19,13 +17,17 @@ reference's continuation schedule from the fixed solve's last iterate, then re-s
 the modes it found), and last the previous plan's next control open loop
 (``MPCStep.fallback``).
 
-Horizon: one env step is one interval (the env runs at the reference's h, ``env_options``), and
-t_f = N h. A plan of N intervals is followed by one of N - 1 (the env's steps left); a
-time-optimal problem shrinks by a step while the goal stays reachable and takes extra steps
-only where it does not (it never looks for an arrival earlier than planned). An earlier
-design kept t_f free on N equal intervals near h: its plans were not on the env's grid (each
-interval held for h instead of t_f / N; the last ones 11 ms long, held for 35.5 ms, overshot
-the goal), and the closed loop lost 9 % over its first plans (optimal/README.md).
+Horizon: one env step is one interval (the env runs at the reference's h, ``env_options``).
+Effort problems have t_f fixed, N - k intervals of h left at step k. Time-optimal problems
+plan on one of two grids (``GRIDS``; per reference ``GRID_OF_REFERENCE``):
+
+* ``"env"``: the env's grid, t_f = N h. The control applied is held for exactly as long as
+  planned and the plan ends at the end of an env step; a plan of N steps is followed by one of
+  N - 1 while the goal stays reachable, and by one 1 to ``MAX_EXTRA_STEPS`` steps longer where
+  it does not (it never looks for an arrival earlier than planned).
+* ``"free"``: t_f free on N equal intervals; the remaining plan keeps N - 1 intervals while
+  they stay within ``REGRID_TOLERANCE`` of h, and is re-gridded to max(round(t_remaining / h),
+  ``min_horizon``) intervals beyond that. Each interval of t_f / N is held for h by the env.
 
 ``ShrinkingHorizonMPC(reference)`` is a policy: ``controller(observation) -> action`` in the
 env's default Box action space (the observation is decoded into (q, u): the manipulator's
@@ -54,7 +56,23 @@ from optimal.problems import make_problem
 from optimal.references import Reference
 from optimal.solution import SLIP_TOLERANCE, read_modes, read_solution, values_at
 from optimal.solve import SCHEDULES
-from optimal.transcription import GUESS_IMPULSES, Transcription
+from optimal.transcription import GUESS_IMPULSES, Transcription, regridded_impulses
+
+GRIDS = ("env", "free")
+"""The grids a time-optimal plan is on (the module docstring)."""
+
+GRID_OF_REFERENCE = {"manipulator_time": "env", "diff_drive_time": "free"}
+"""The grid of each time-optimal reference's MPC, by measurement (optimal/README.md). The
+manipulator on the free grid lost 9 % of the optimal time in closed loop at perturbation 0.1
+(its plans' last intervals, 11 ms long, held for 35.5 ms, overshot the goal) and reached
+1.10x; on the env's grid 0.985x. The robot on the env's grid spent over 4 min on its first
+step from a 0.01-perturbed start (the fixed-time, fixed-pattern NLPs fail and the fallbacks
+build dozens more), where the free grid reaches 1.0045x at 0.1 at 0.26 s per step."""
+
+MIN_HORIZON = 1
+"""Fewest intervals a re-solve on the free grid plans over. The horizon is re-gridded to keep
+each planned interval near the env step h (a plan of 4 intervals in 0.5 h, held for h each,
+ran past the goal)."""
 
 STEP_MAX_ITERATIONS = 200
 """IPOPT's iteration limit per control step (warm-started solves take 5-40)."""
@@ -77,9 +95,17 @@ intervals: a measured state off the plan puts the imminent mode in doubt, not a 
 ahead. All neighbours of a robot plan (3 contacts) were 20-27 new NLPs, 30-50 s per fallback."""
 
 MAX_EXTRA_STEPS = 3
-"""A time-optimal re-plan that cannot reach the goal in the env steps left tries arriving 1, 2,
-... this many steps later (warm-started from ``Plan.delayed``); longer detours are not
-taken."""
+"""On the env's grid, a time-optimal re-plan that cannot reach the goal in the env steps left
+tries arriving 1, 2, ... this many steps later (warm-started from ``Plan.delayed``); longer
+detours are not taken."""
+
+REGRID_TOLERANCE = 0.25
+"""On the free grid, a plan is re-gridded to steps of h when its intervals differ from the env
+step h by more than this fraction (``ShrinkingHorizonMPC._horizon_after_step``)."""
+
+MAX_REPLAN_GROWTH = 1.5
+"""On the free grid, a re-plan longer than this times the previous remaining time (plus one
+step) is a detour through another local optimum, and is not taken."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,9 +133,10 @@ class Plan:
         """N."""
         return int(self.tau.shape[0])
 
-    def shifted(self) -> Plan:
+    def shifted(self, num_intervals: int | None = None) -> Plan:
         """The plan from its second grid point on.
 
+        Re-gridded to ``num_intervals`` (default: one less, no re-gridding) by ``regridded``.
         A plan of one interval continues as that interval repeated from its end state.
         """
         step = self.final_time / self.num_intervals
@@ -122,7 +149,9 @@ class Plan:
                                       for rows in (self.modes.engaged, self.modes.sliding))),
                         self.final_time - step,
                         {key: value[1:] for key, value in self.impulses.items()})
-        return rest
+        if num_intervals is None or num_intervals == rest.num_intervals:
+            return rest
+        return rest.regridded(num_intervals)
 
     def delayed(self, steps: int) -> Plan:
         """The plan with its first interval repeated ``steps`` times in front.
@@ -141,6 +170,28 @@ class Plan:
                     self.final_time + steps * step,
                     {key: value[intervals] for key, value in self.impulses.items()})
 
+    def regridded(self, num_intervals: int) -> Plan:
+        """The same plan on ``num_intervals`` intervals of equal length.
+
+        Each input, impulse and mode is the one of the old interval holding the new
+        interval's midpoint (impulses scaled by the ratio of the interval lengths, slip speeds
+        not); q and u interpolate linearly.
+        """
+        old = np.linspace(0.0, 1.0, self.num_intervals + 1)
+        new = np.linspace(0.0, 1.0, num_intervals + 1)
+        midpoints = (new[:-1] + new[1:]) / 2
+        holder = np.minimum(np.searchsorted(old, midpoints, side="right") - 1,
+                            self.num_intervals - 1)
+
+        def interpolated(values: FloatArray) -> FloatArray:
+            return np.column_stack([np.interp(new, old, column) for column in values.T])
+
+        modes = ModePattern(*(None if rows is None else rows[:, holder]
+                              for rows in (self.modes.engaged, self.modes.sliding)))
+        impulses = regridded_impulses(self.impulses, holder, self.num_intervals / num_intervals)
+        return Plan(interpolated(self.q), interpolated(self.u), self.tau[holder], modes,
+                    self.final_time, impulses)
+
 
 @dataclass(frozen=True)
 class MPCStep:
@@ -151,7 +202,8 @@ class MPCStep:
             remaining maneuver [s] or its effort). status: IPOPT's. iterations: IPOPT's.
         compute_time: wall time of the step's NLP build and solves [s].
         fallback: "" (fixed-pattern solve), "pattern shifted" (a neighbouring pattern),
-            "goal relaxed", "K step(s) later" (time problems: arriving K env steps later),
+            "goal relaxed", "K step(s) later" (time problems on the env's grid: arriving K env
+            steps later),
             "freed" (pattern freed too), or "open loop" (all failed: the previous plan's
             control).
     """
@@ -171,17 +223,26 @@ class ShrinkingHorizonMPC:
     Args:
         reference: the reference whose problem is re-solved (``optimal.references``);
             its grid step h must be the env's dt.
-        max_iterations: see ``STEP_MAX_ITERATIONS``.
+        grid: a time-optimal plan's grid, one of ``GRIDS`` (None: ``GRID_OF_REFERENCE``, else
+            "env"); effort problems are always on the env's grid.
+        min_horizon: see ``MIN_HORIZON``. max_iterations: see ``STEP_MAX_ITERATIONS``.
 
     Attributes:
         steps: the ``MPCStep`` records of this episode. nlps_built: NLPs built so far (the
             rest of the fixed-pattern solves reused one, ``NLP_CACHE_SIZE``).
     """
 
-    def __init__(self, reference: Reference, max_iterations: int = STEP_MAX_ITERATIONS) -> None:
+    def __init__(self, reference: Reference, grid: str | None = None,
+                 min_horizon: int = MIN_HORIZON,
+                 max_iterations: int = STEP_MAX_ITERATIONS) -> None:
+        grid = grid if grid is not None else GRID_OF_REFERENCE.get(reference.name, "env")
+        if grid not in GRIDS:
+            raise ValueError(f"grid must be one of {GRIDS}, got {grid!r}")
         self.reference = reference
         self.base = make_problem(reference.name, len(reference.tau))
+        self.grid = grid if self.base.cost == "time" else "env"
         self.time_step = reference.time_step
+        self.min_horizon = int(min_horizon)
         self.max_iterations = int(max_iterations)
         self.schedule = SCHEDULES.get(reference.name) or Schedule()
         self.steps: list[MPCStep] = []
@@ -248,24 +309,47 @@ class ShrinkingHorizonMPC:
     def _next_guess(self) -> Plan:
         if self._plan is None:
             return _reference_plan(self.reference)
-        return self._plan.shifted()
+        if self.grid == "env":
+            return self._plan.shifted()
+        return self._plan.shifted(self._horizon_after_step(self._plan))
+
+    def _horizon_after_step(self, plan: Plan) -> int:
+        """Intervals of a free-grid plan's rest: one fewer, or re-gridded to steps of h.
+
+        The rest keeps its N - 1 intervals while their length stays within
+        ``REGRID_TOLERANCE`` of the env step h; beyond that it is re-gridded to
+        round(remaining / h) intervals (at least ``min_horizon``). Each kept step shortens the
+        remaining time by h (the env's step) and the plan by one interval, so the plan's excess
+        over N h is carried unchanged and the next switch comes one interval nearer. Re-gridding
+        whenever rounding said so kept N at every step once the excess neared half a step, and
+        the plan stalled: its next switch stayed as far ahead (a 0.03-perturbed manipulator
+        episode planned 3.46 s to go for 27 steps and took 1.39x the optimum).
+        """
+        remaining = plan.final_time - plan.final_time / plan.num_intervals
+        kept = plan.num_intervals - 1
+        if kept >= self.min_horizon and abs(remaining / kept / self.time_step - 1.0) \
+                <= REGRID_TOLERANCE:
+            return kept
+        return max(int(round(remaining / self.time_step)), self.min_horizon)
 
     def _nlp(self, modes: ModePattern, relaxed: bool, q: FloatArray,
              u: FloatArray) -> Transcription:
         """The fixed-pattern NLP of the remaining problem from (q, u), built once per key.
 
         The key is (intervals, pattern, goal relaxed); the start is the NLP's parameter. t_f is
-        the intervals times h (on a time-optimal problem, by its bounds: the NLP is then a
-        feasibility problem, the cost being the number of intervals).
+        the intervals times h (on a time-optimal problem on the env's grid by its bounds: the
+        NLP is then a feasibility problem, the cost being the number of intervals), or free
+        (from ~0) on the free grid.
         The least recently used NLP is dropped past ``NLP_CACHE_SIZE``.
         """
         key = (modes.num_intervals, modes.key(), relaxed)
         transcription = self._nlps.pop(key, None)
         if transcription is None:
             final_time = modes.num_intervals * self.time_step
+            bounds = ((final_time, final_time) if self.grid == "env"
+                      else (1e-3 * self.time_step, self.base.final_time_bounds[1]))
             problem = dataclasses.replace(self.base, num_intervals=modes.num_intervals,
-                                          final_time=final_time,
-                                          final_time_bounds=(final_time, final_time))
+                                          final_time=final_time, final_time_bounds=bounds)
             if relaxed:
                 q_tolerance, u_tolerance = self._goal_tolerances()
                 problem = dataclasses.replace(problem, goal_q_tolerance=q_tolerance,
@@ -300,19 +384,20 @@ class ShrinkingHorizonMPC:
         """The step's plan: fixed pattern, neighbours, goal relaxed, later arrival, freed."""
         initial = self._initial_point(guess, q, u)
         solve, transcription = self._fixed(guess.modes, False, q, u, initial)
-        if solve.success:
+        if self._acceptable(solve, guess):
             return solve, _plan_of(solve, transcription), ""
         if guess.num_intervals > 1:
             candidates = [self._fixed(pattern, False, q, u, initial)
                           for pattern in _imminent_neighbours(guess.modes)]
-            accepted = [pair for pair in candidates if pair[0].success]
+            accepted = [pair for pair in candidates if self._acceptable(pair[0], guess)]
             if accepted:
                 best = min(accepted, key=lambda pair: pair[0].cost)
                 return best[0], _plan_of(*best), "pattern shifted"
         solve, transcription = self._fixed(guess.modes, True, q, u, initial)
-        if solve.success:
+        if self._acceptable(solve, guess):
             return solve, _plan_of(solve, transcription), "goal relaxed"
-        for extra in range(1, MAX_EXTRA_STEPS + 1 if self.base.cost == "time" else 1):
+        extra_steps = MAX_EXTRA_STEPS if self.base.cost == "time" and self.grid == "env" else 0
+        for extra in range(1, extra_steps + 1):
             longer = guess.delayed(extra)
             longer_initial = self._initial_point(longer, q, u)
             for relaxed_goal in (False, True):
@@ -320,8 +405,8 @@ class ShrinkingHorizonMPC:
                                                    longer_initial)
                 if solve.success:
                     return solve, _plan_of(solve, transcription), f"{extra} step(s) later"
-        longest = guess.delayed(MAX_EXTRA_STEPS) if self.base.cost == "time" else guess
-        if longest is not guess:  # time problems: freed over the longest horizon allowed
+        longest = guess.delayed(extra_steps) if extra_steps else guess
+        if longest is not guess:  # freed over the longest horizon allowed
             initial = self._initial_point(longest, q, u)
         relaxed = self._nlp(longest.modes, True, q, u).problem
         free = Transcription(relaxed, parametric_start=True)
@@ -332,9 +417,20 @@ class ShrinkingHorizonMPC:
             point = np.asarray(freed.values(solved.opti.x), dtype=float).ravel()
             again, transcription = self._fixed(read_modes(solved, freed.values), True, q, u,
                                                point)
-            if again.success:
+            if self._acceptable(again, guess):
                 return again, _plan_of(again, transcription), "freed"
         return None, guess, "open loop"
+
+    def _acceptable(self, solve: ModeSolve, guess: Plan) -> bool:
+        """Whether a re-plan is taken.
+
+        It must have converged and, on the free grid, not be a detour: t_f at most
+        ``MAX_REPLAN_GROWTH`` times the guess's plus one step.
+        """
+        if not solve.success:
+            return False
+        return self.grid == "env" or solve.final_time <= (
+            MAX_REPLAN_GROWTH * guess.final_time + self.time_step)
 
     def _goal_tolerances(self) -> tuple[float, float]:
         """(q, u) tolerances: ``GOAL_TOLERANCE_FRACTION`` of the task's success box."""
@@ -380,7 +476,8 @@ def _reference_plan(reference: Reference) -> Plan:
 
 
 __all__ = [
-    "GOAL_TOLERANCE_FRACTION", "MAX_EXTRA_STEPS", "NEIGHBOUR_WINDOW", "NLP_CACHE_SIZE",
+    "GOAL_TOLERANCE_FRACTION", "GRIDS", "GRID_OF_REFERENCE", "MAX_EXTRA_STEPS",
+    "MAX_REPLAN_GROWTH", "MIN_HORIZON", "NEIGHBOUR_WINDOW", "NLP_CACHE_SIZE", "REGRID_TOLERANCE",
     "STEP_MAX_ITERATIONS",
     "MPCStep", "Plan", "ShrinkingHorizonMPC",
 ]

@@ -11,6 +11,7 @@ from mdi_envs.rollout import rollout  # noqa: E402
 from optimal.continuation import solve_continuation  # noqa: E402
 from optimal.modes import ModePattern  # noqa: E402
 from optimal.mpc import (  # noqa: E402
+    GRID_OF_REFERENCE,
     NEIGHBOUR_WINDOW,
     Plan,
     ShrinkingHorizonMPC,
@@ -81,7 +82,7 @@ def test_a_second_episode_reuses_the_built_nlps(short_reference) -> None:  # noq
     np.testing.assert_allclose(second_costs, first_costs, rtol=1e-6)
 
 
-def test_plan_shift_and_delay_keep_the_trajectory() -> None:
+def test_plan_shift_delay_and_regrid_keep_the_trajectory() -> None:
     time = np.linspace(0.0, 1.0, 5)
     q = np.column_stack([time, time**2])
     plan = Plan(q, q.copy(), np.arange(4.0)[:, None],
@@ -95,9 +96,13 @@ def test_plan_shift_and_delay_keep_the_trajectory() -> None:
     np.testing.assert_array_equal(later.q, q[[0, 0, 0, 1, 2, 3, 4]])
     assert later.tau[:, 0].tolist() == [0, 0, 0, 1, 2, 3]
     assert later.modes.engaged.tolist() == [[False, False, False, True, True, False]]
+    fine = plan.regridded(8)
+    np.testing.assert_allclose(fine.q[::2], q)
+    assert fine.tau[:, 0].tolist() == [0, 0, 1, 1, 2, 2, 3, 3]
     last = Plan(q[-2:], q[-2:], np.ones((1, 1)), ModePattern(engaged=np.array([[True]])), 0.25)
     held = last.shifted()
     assert held.num_intervals == 1 and np.allclose(held.q, q[-1])
+    assert last.shifted(2).num_intervals == 2
 
 
 def test_the_neighbour_fallback_moves_only_imminent_modes() -> None:
@@ -132,3 +137,38 @@ def test_a_start_needing_more_steps_than_left_gets_them(short_reference) -> None
     step = controller.steps[-1]
     assert step.fallback == "2 step(s) later" and step.horizon == SHORT_N
     assert step.cost == pytest.approx(short_reference.final_time, rel=1e-6)
+
+
+def test_a_free_grid_plan_slightly_slower_than_h_still_shrinks(short_reference) -> None:  # noqa: ANN001
+    """The rest keeps N - 1 intervals within ``REGRID_TOLERANCE`` of h; re-grids beyond."""
+    controller = ShrinkingHorizonMPC(short_reference, grid="free")
+    h = controller.time_step
+
+    def plan(num_intervals: int, interval: float) -> Plan:
+        q = np.zeros((num_intervals + 1, 2))
+        return Plan(q, q.copy(), np.zeros((num_intervals, 1)),
+                    ModePattern(engaged=np.zeros((1, num_intervals), dtype=bool)),
+                    num_intervals * interval)
+
+    # intervals 0.7 % longer than h: rounding alone gives 97 again, the next switch never nears
+    assert round(96 * 1.007) == 97
+    assert controller._horizon_after_step(plan(97, 1.007 * h)) == 96
+    # intervals more than REGRID_TOLERANCE off h: re-gridded to steps of h
+    assert controller._horizon_after_step(plan(20, 1.4 * h)) == 27  # 19 x 1.4 = 26.6
+    assert controller._horizon_after_step(plan(20, 0.6 * h)) == 11  # 19 x 0.6 = 11.4
+    assert controller._horizon_after_step(plan(1, h)) == 1  # held at min_horizon
+
+
+def test_the_free_grid_mpc_reaches_the_goal(short_reference) -> None:  # noqa: ANN001
+    options = env_options(short_reference)
+    options.update(reset_noise_scale=0.01, max_episode_steps=2 * SHORT_N)
+    controller = ShrinkingHorizonMPC(short_reference, grid="free")
+    result = rollout(short_reference.metadata["env_id"], controller, seed=1, **options)
+    assert result.last_info["is_success"]
+    assert any(step.horizon != SHORT_N - step.step for step in controller.steps)  # re-gridded
+
+
+def test_the_grid_is_chosen_per_reference_and_checked(short_reference) -> None:  # noqa: ANN001
+    assert ShrinkingHorizonMPC(short_reference).grid == GRID_OF_REFERENCE["manipulator_time"]
+    with pytest.raises(ValueError, match="grid must be one of"):
+        ShrinkingHorizonMPC(short_reference, grid="fine")
