@@ -203,9 +203,8 @@ class MPCStep:
         compute_time: wall time of the step's NLP build and solves [s].
         fallback: "" (fixed-pattern solve), "pattern shifted" (a neighbouring pattern),
             "goal relaxed", "K step(s) later" (time problems on the env's grid: arriving K env
-            steps later),
-            "freed" (pattern freed too), or "open loop" (all failed: the previous plan's
-            control).
+            steps later), "freed" (pattern freed too), or "open loop" (all failed: the previous
+            plan's control).
     """
 
     step: int
@@ -403,10 +402,11 @@ class ShrinkingHorizonMPC:
             for relaxed_goal in (False, True):
                 solve, transcription = self._fixed(longer.modes, relaxed_goal, q, u,
                                                    longer_initial)
-                if solve.success:
+                if self._acceptable(solve, longer):
                     return solve, _plan_of(solve, transcription), f"{extra} step(s) later"
-        longest = guess.delayed(extra_steps) if extra_steps else guess
-        if longest is not guess:  # freed over the longest horizon allowed
+        longest = guess
+        if extra_steps:  # freed over the longest horizon allowed
+            longest = guess.delayed(extra_steps)
             initial = self._initial_point(longest, q, u)
         relaxed = self._nlp(longest.modes, True, q, u).problem
         free = Transcription(relaxed, parametric_start=True)
