@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from tqdm import tqdm
 
 from baselines.compare import (
     REFERENCE_NAMES,
@@ -107,12 +108,13 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                scales: Sequence[float] = SCALES, trained_dir: Path = TRAINED_DIR,
                log: Callable[[str], None] | None = None,
                mismatches: bool | Sequence[str] = True,
-               only: Sequence[str] | None = None) -> dict[str, Any]:
+               only: Sequence[str] | None = None, show_bar: bool = False) -> dict[str, Any]:
     """Play every controller under every condition (see the module docstring).
 
     ``mismatches=False`` plays the perturbation scales only, a sequence of labels (of
     ``MISMATCHES[env_id]``) only those mismatches; ``only`` names the controllers to play
     (labels, e.g. "PPO"; None: all), for a study completed piece by piece (``merge_studies``).
+    ``show_bar``: a tqdm bar over the episodes on stderr.
 
     Returns:
         {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort", "seeds",
@@ -139,10 +141,12 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                    for label in factories if label in mismatch_labels]
     available = controllers_for(env_id, task, mpc, trained_dir)
     require_known_labels(only, [label for label, _ in available], env_id, task)
+    playing = [(label, runs) for label, runs in available if only is None or label in only]
+    bar = tqdm(total=num_seeds * len(conditions) * sum(len(runs) for _, runs in playing),
+               desc=f"{env_id.split('/')[-1]} {task}", unit="episode", mininterval=10.0,
+               disable=not show_bar)
     rows = []
-    for label, runs in available:
-        if only is not None and label not in only:
-            continue
+    for label, runs in playing:
         results = []
         for condition in conditions:
             summaries = []
@@ -151,8 +155,10 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                                           "reset_noise_scale": condition["scale"]}
                 if condition["mismatch"] is not None:
                     kwargs["parameters"] = factories[str(condition["mismatch"])]()
-                episodes = [play(env_id, controller.make_policy, seed, True, **kwargs)
-                            for seed in range(num_seeds)]
+                episodes = []
+                for seed in range(num_seeds):
+                    episodes.append(play(env_id, controller.make_policy, seed, True, **kwargs))
+                    bar.update()
                 summaries.append(summarize(episodes, optimal_time, optimal_effort))
             rates = [s["success_rate"] for s in summaries]
             result = {"condition": condition["label"], "success_rate": float(np.mean(rates)),
@@ -164,6 +170,7 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
             say(f"{env_id} {task} {label} [{condition['label']}]: success "
                 f"{result['success_rate']:.0%} over {len(runs)} run(s) x {num_seeds} starts")
         rows.append({"label": label, "runs": len(runs), "results": results})
+    bar.close()
     return {"env_id": env_id, "task": task, "reference": reference.name,
             "optimal_time": optimal_time, "optimal_effort": optimal_effort,
             "seeds": num_seeds, "conditions": conditions, "controllers": rows}
@@ -287,10 +294,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(f"{args.env_id} has no task {args.task!r}")
     for env_id, task in jobs:
         study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
-                           log=lambda line: print(line, file=sys.stderr, flush=True),
+                           log=lambda line: tqdm.write(line, file=sys.stderr),
                            mismatches=(args.mismatches if args.mismatch and args.mismatches
                                        else args.mismatch),
-                           only=args.controllers)
+                           only=args.controllers, show_bar=True)
         stem = f"robustness_{env_id.split('/')[-1]}_{task}"
         args.output.mkdir(parents=True, exist_ok=True)
         path = args.output / f"{stem}.json"
