@@ -33,7 +33,7 @@ import warnings
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import gymnasium as gym
 import numpy as np
@@ -253,7 +253,31 @@ def load_policy(config_path: Path) -> tuple[Controller, dict[str, Any]]:
     return Controller(config["algo"], lambda _env: act, dict(config["env_kwargs"])), config
 
 
-def summarize(episodes: Sequence[Episode], optimal_time: float, optimal_effort: float
+class EpisodeScores(Protocol):
+    """What ``summarize`` reads of an episode (an ``Episode``, or a stored one's scores)."""
+
+    @property
+    def is_success(self) -> bool:
+        """Ended at the goal."""
+
+    @property
+    def elapsed_time(self) -> float:
+        """Simulated time at the end [s]."""
+
+    @property
+    def effort(self) -> float:
+        """Integral of sum(tau^2) [N^2 m^2 s]."""
+
+    @property
+    def solver_failures(self) -> int:
+        """Steps whose contact solve did not converge."""
+
+    @property
+    def compute_per_step(self) -> float:
+        """Mean wall time of one policy call [s]."""
+
+
+def summarize(episodes: Sequence[EpisodeScores], optimal_time: float, optimal_effort: float
               ) -> dict[str, Any]:  # fmt: skip
     """Success rate and, over the successes, time and effort as ratios to the optimum.
 
@@ -542,10 +566,9 @@ def collect_tables(output: Path) -> str:
 __all__ = [
     "CONTROLLER_FACTORIES", "OPTIMAL", "REFERENCE_NAMES", "SCORES", "TASKS", "TRAINED_DIR",
     "TRAJECTORY_FIELDS",
-    "Controller", "Episode", "aggregate_runs", "collect_tables", "compare", "comparison_record",
-    "evaluate_controller", "group_by_algorithm", "interval_text", "load_policy",
-    "markdown_table", "merge_comparisons", "optimal_controller", "play", "reference_controller",
-    "reference_effort", "registered_controllers", "require_known_labels", "shipped_algorithms",
-    "shipped_policies",
-    "summarize", "write_comparison",
+    "Controller", "Episode", "EpisodeScores", "aggregate_runs", "collect_tables", "compare",
+    "comparison_record", "evaluate_controller", "group_by_algorithm", "interval_text",
+    "load_policy", "markdown_table", "merge_comparisons", "optimal_controller", "play",
+    "reference_controller", "reference_effort", "registered_controllers", "require_known_labels",
+    "shipped_algorithms", "shipped_policies", "summarize", "write_comparison",
 ]

@@ -19,7 +19,9 @@ controller; success under each mismatch) and ``robustness.md`` (the table of eve
 ``robustness_*.json`` in the output folder). ``--controllers LABEL ... [--scales ...]
 [--no-mismatch | --mismatches LABEL ...]`` plays only those and merges their results into the
 study in the folder (``merge_studies``), so a slow controller's conditions can be run one at a
-time (``--scales`` with no value plays no perturbation scale).
+time (``--scales`` with no value plays no perturbation scale). Every finished episode is
+appended to ``episodes.jsonl`` in the output folder; ``--resume`` plays only the episodes not
+in it, so a long run (the MPC under a mismatch: minutes per episode) can stop and go on later.
 """
 
 from __future__ import annotations
@@ -27,8 +29,10 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import sys
 from collections.abc import Callable, Collection, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -104,17 +108,79 @@ def controllers_for(env_id: str, task: str, mpc: bool = False,
     return rows
 
 
+EPISODES_FILE = "episodes.jsonl"
+"""The CLI's file of finished episodes in its output folder (``--resume`` reads it)."""
+
+
+@dataclass(frozen=True)
+class EpisodeRecord:
+    """One finished episode of the study, as kept in the episodes file (no trajectory).
+
+    Attributes:
+        env_id, task: the study. controller: its label. run: index of the controller's run
+        (a trained algorithm's seed). condition: the condition's label. seed: the reset seed.
+        is_success, elapsed_time [s], effort [N^2 m^2 s], solver_failures, compute_per_step
+        [s]: as ``baselines.compare.Episode``.
+    """
+
+    env_id: str
+    task: str
+    controller: str
+    run: int
+    condition: str
+    seed: int
+    is_success: bool
+    elapsed_time: float
+    effort: float
+    solver_failures: int
+    compute_per_step: float
+
+
+def read_episodes(path: Path | None, env_id: str, task: str
+                  ) -> dict[tuple[str, int, str, int], EpisodeRecord]:  # fmt: skip
+    """{(controller, run, condition, seed): record} of the study (env id, task) in ``path``.
+
+    A missing file is an empty one; a last line cut short (a run killed while writing) is
+    skipped.
+    """
+    if path is None or not path.exists():
+        return {}
+    records = {}
+    for line in path.read_text().splitlines():
+        try:
+            record = EpisodeRecord(**json.loads(line))
+        except (json.JSONDecodeError, TypeError):
+            continue
+        if (record.env_id, record.task) == (env_id, task):
+            records[(record.controller, record.run, record.condition, record.seed)] = record
+    return records
+
+
+def _append(path: Path, record: EpisodeRecord) -> None:
+    """One JSON line at the end of ``path``, after a newline if its last line was cut short."""
+    with path.open("a+b") as stream:
+        if stream.seek(0, os.SEEK_END):
+            stream.seek(-1, os.SEEK_END)
+            if stream.read(1) != b"\n":
+                stream.write(b"\n")
+        stream.write(json.dumps(dataclasses.asdict(record)).encode() + b"\n")
+
+
 def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                scales: Sequence[float] = SCALES, trained_dir: Path = TRAINED_DIR,
                log: Callable[[str], None] | None = None,
                mismatches: bool | Sequence[str] = True,
-               only: Sequence[str] | None = None, show_bar: bool = False) -> dict[str, Any]:
+               only: Sequence[str] | None = None, show_bar: bool = False,
+               episodes_path: Path | None = None, resume: bool = False) -> dict[str, Any]:
     """Play every controller under every condition (see the module docstring).
 
     ``mismatches=False`` plays the perturbation scales only, a sequence of labels (of
     ``MISMATCHES[env_id]``) only those mismatches; ``only`` names the controllers to play
     (labels, e.g. "PPO"; None: all), for a study completed piece by piece (``merge_studies``).
-    ``show_bar``: a tqdm bar over the episodes on stderr.
+    ``show_bar``: a tqdm bar over the episodes on stderr. ``episodes_path``: a JSON-lines file
+    to which each finished episode is appended (``EpisodeRecord``); with ``resume`` the
+    episodes already in it are not played again, so an interrupted study goes on where it
+    stopped.
 
     Returns:
         {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort", "seeds",
@@ -145,19 +211,29 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
     bar = tqdm(total=num_seeds * len(conditions) * sum(len(runs) for _, runs in playing),
                desc=f"{env_id.split('/')[-1]} {task}", unit="episode", mininterval=10.0,
                disable=not show_bar)
+    finished = read_episodes(episodes_path, env_id, task) if resume else {}
     rows = []
     for label, runs in playing:
         results = []
         for condition in conditions:
             summaries = []
-            for controller in runs:
+            for run, controller in enumerate(runs):
                 kwargs: dict[str, Any] = {**controller.env_kwargs,
                                           "reset_noise_scale": condition["scale"]}
                 if condition["mismatch"] is not None:
                     kwargs["parameters"] = factories[str(condition["mismatch"])]()
                 episodes = []
                 for seed in range(num_seeds):
-                    episodes.append(play(env_id, controller.make_policy, seed, True, **kwargs))
+                    key = (label, run, str(condition["label"]), seed)
+                    record = finished.get(key)
+                    if record is None:
+                        episode = play(env_id, controller.make_policy, seed, True, **kwargs)
+                        record = EpisodeRecord(
+                            env_id, task, *key, episode.is_success, episode.elapsed_time,
+                            episode.effort, episode.solver_failures, episode.compute_per_step)
+                        if episodes_path is not None:
+                            _append(episodes_path, record)
+                    episodes.append(record)
                     bar.update()
                 summaries.append(summarize(episodes, optimal_time, optimal_effort))
             rates = [s["success_rate"] for s in summaries]
@@ -285,6 +361,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                         "their results into the study already in --output")
     parser.add_argument("--trained", type=Path, default=TRAINED_DIR)
     parser.add_argument("--output", type=Path, default=Path("results/robustness"))
+    parser.add_argument("--resume", action="store_true",
+                        help="reuse the episodes already in OUTPUT/episodes.jsonl (every "
+                        "finished episode is appended there): an interrupted run goes on")
     args = parser.parse_args(argv)
     if args.seeds < 1:
         parser.error(f"--seeds must be >= 1, got {args.seeds}")
@@ -292,14 +371,15 @@ def main(argv: Sequence[str] | None = None) -> int:
             if args.env_id in ("all", key[0]) and args.task in (None, key[1])]
     if not jobs:
         parser.error(f"{args.env_id} has no task {args.task!r}")
+    args.output.mkdir(parents=True, exist_ok=True)
     for env_id, task in jobs:
         study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
                            log=lambda line: tqdm.write(line, file=sys.stderr),
                            mismatches=(args.mismatches if args.mismatch and args.mismatches
                                        else args.mismatch),
-                           only=args.controllers, show_bar=True)
+                           only=args.controllers, show_bar=True,
+                           episodes_path=args.output / EPISODES_FILE, resume=args.resume)
         stem = f"robustness_{env_id.split('/')[-1]}_{task}"
-        args.output.mkdir(parents=True, exist_ok=True)
         path = args.output / f"{stem}.json"
         if args.controllers is not None and path.exists():
             study = merge_studies(json.loads(path.read_text()), study,
@@ -315,7 +395,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-__all__ = ["DEFAULT_SCALE", "MISMATCHES", "SCALES", "controllers_for", "main", "markdown_table",
+__all__ = ["DEFAULT_SCALE", "EPISODES_FILE", "MISMATCHES", "SCALES", "EpisodeRecord",
+           "controllers_for", "main", "markdown_table", "read_episodes",
            "merge_studies", "plot_robustness", "robustness"]
 
 

@@ -4,12 +4,20 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from baselines.robustness import MISMATCHES, main, merge_studies, robustness  # noqa: E402
+import baselines.robustness as robustness_module  # noqa: E402
+from baselines.robustness import (  # noqa: E402
+    MISMATCHES,
+    main,
+    merge_studies,
+    read_episodes,
+    robustness,
+)
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters  # noqa: E402
 
 ROBOT = "mdi_envs/DiffDriveRobot-v0"
@@ -46,6 +54,8 @@ def test_cli_writes_json_plot_and_table(tmp_path: Path) -> None:
     assert study["task"] == "effort" and study["seeds"] == 1
     assert (out / "robustness_DiffDriveRobot-v0_effort.png").stat().st_size > 0
     assert "| optimal (open loop) | 1 |" in (out / "robustness.md").read_text()
+    # one line per episode: the open loop under 0.01 and the four mismatches
+    assert len((out / "episodes.jsonl").read_text().splitlines()) == 5
     # a rerun of another env x task keeps this one's rows in robustness.md
     assert main([ROBOT, "--task", "time", "--seeds", "1", "--scales", "0.01", "--no-mismatch",
                  "--trained", str(tmp_path), "--output", str(out)]) == 0
@@ -93,3 +103,31 @@ def test_an_unknown_controller_label_is_an_error(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"no controller 'PP0'.*known: optimal \(open loop\)"):
         robustness(ROBOT, "effort", num_seeds=1, scales=(0.01,), trained_dir=tmp_path,
                    mismatches=False, only=["PP0"])
+
+
+def test_an_interrupted_study_resumes_from_its_episodes(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    path = tmp_path / "episodes.jsonl"
+    options = {"num_seeds": 2, "scales": (0.01,), "mismatches": False, "trained_dir": tmp_path,
+               "episodes_path": path}
+    first = robustness(ROBOT, "effort", **options)
+    lines = path.read_text().splitlines()
+    assert [json.loads(line)["seed"] for line in lines] == [0, 1]
+    # killed while writing seed 1: its line cut short
+    path.write_text(lines[0] + "\n" + lines[1][:20])
+    played: list[int] = []
+    real_play = robustness_module.play
+
+    def counting_play(*args: Any, **kwargs: Any) -> Any:
+        played.append(args[2])
+        return real_play(*args, **kwargs)
+
+    monkeypatch.setattr(robustness_module, "play", counting_play)
+    assert robustness(ROBOT, "effort", **options, resume=True) == first
+    assert played == [1]  # seed 0 read back, seed 1 played again
+    assert read_episodes(path, ROBOT, "effort").keys() == {
+        ("optimal (open loop)", 0, "perturbation 0.01", seed) for seed in (0, 1)}
+    assert read_episodes(path, ROBOT, "time") == {}
+    played.clear()
+    assert robustness(ROBOT, "effort", **options) == first  # without resume: every episode
+    assert played == [0, 1]
