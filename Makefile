@@ -2,7 +2,9 @@
 # what it needs. CI sets TORCH_SPEC=torch==2.13.0 so that pip takes the local CPU wheel before
 # anything can pull the CUDA build; ordinary users leave it empty and get torch the normal way
 # when they install the `rl` extra. Both first compile every env kernel into the disk cache
-# (`mdi-envs compile all`), so that the processes after it start warm.
+# (`mdi-envs compile all`), so that the processes after it start warm. The tests run on every
+# core (pytest-xdist); --dist loadfile keeps each file on one worker, so that a module's fixture
+# (the kernel-cache tests compile into an empty cache) runs once.
 
 PYTHON ?= python3
 VENV ?= .venv
@@ -26,7 +28,7 @@ demo: $(VENV)/.installed-rl,render
 
 test: $(VENV)/.installed-test
 	$(BIN)/mdi-envs compile all
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=10
 	$(BIN)/mdi-envs bench --quick
 
 bench: $(VENV)/.installed-bench
