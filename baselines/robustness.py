@@ -32,7 +32,6 @@ import json
 import os
 import sys
 from collections.abc import Callable, Collection, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -112,7 +111,7 @@ EPISODES_FILE = "episodes.jsonl"
 """The CLI's file of finished episodes in its output folder (``--resume`` reads it)."""
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class EpisodeRecord:
     """One finished episode of the study, as kept in the episodes file (no trajectory).
 
