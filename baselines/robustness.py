@@ -305,7 +305,10 @@ def markdown_table(studies: Sequence[dict[str, Any]]) -> str:
 
 
 def plot_robustness(study: dict[str, Any], path: Path) -> Path:
-    """Success against the perturbation scale per controller, and under each mismatch."""
+    """Success against the perturbation scale per controller, and under each mismatch.
+
+    Each mismatch bar is labelled with its success in % ("n/a": that cell was not played).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -320,9 +323,13 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
         played = [c for c in scaled if c["label"] in success]
         left.plot([c["scale"] for c in played], [success[c["label"]] for c in played], "o-",
                   label=f"{row['label']} ({row['runs']} run{'s' * (row['runs'] > 1)})")
-        right.bar(np.arange(len(mismatched)) + k * width,
-                  [success.get(c["label"], np.nan) for c in mismatched], width,
-                  label=row["label"])
+        positions = np.arange(len(mismatched)) + k * width
+        heights = [success.get(c["label"], np.nan) for c in mismatched]
+        right.bar(positions, heights, width, label=row["label"])
+        for position, height in zip(positions, heights, strict=True):  # 0 % and not run show
+            right.text(position, 1.0 if np.isnan(height) else height + 1.0,
+                       "n/a" if np.isnan(height) else f"{height:.0f}", ha="center",
+                       va="bottom", rotation=90, fontsize=6)
     left.set_xscale("log")
     left.set_xlabel("start perturbation scale [rad, rad/s, m, m/s]")
     left.set_ylabel("success [%]")
@@ -332,7 +339,7 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
     right.set_xticks(np.arange(len(mismatched)) + width * (len(study["controllers"]) - 1) / 2)
     right.set_xticklabels([c["label"] for c in mismatched], fontsize=8)
     right.set_ylabel("success [%]")
-    right.set_ylim(0, 103)
+    right.set_ylim(0, 115)
     right.set_title(f"model mismatch (scale {DEFAULT_SCALE:g})")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
