@@ -326,7 +326,7 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
         positions = np.arange(len(mismatched)) + k * width
         heights = [success.get(c["label"], np.nan) for c in mismatched]
         right.bar(positions, heights, width, label=row["label"])
-        for position, height in zip(positions, heights, strict=True):  # 0 % and not run show
+        for position, height in zip(positions, heights, strict=True):  # a 0 % bar has no height
             right.text(position, 1.0 if np.isnan(height) else height + 1.0,
                        "n/a" if np.isnan(height) else f"{height:.0f}", ha="center",
                        va="bottom", rotation=90, fontsize=6)
