@@ -241,11 +241,10 @@ def shipped_algorithms(env_id: str, task: str, directory: Path = TRAINED_DIR) ->
 
 def load_policy(config_path: Path) -> tuple[Controller, dict[str, Any]]:
     """A trained policy (deterministic ``predict``) as a ``Controller``, and its config."""
-    from baselines.train import algorithm_class
+    from baselines.train import load_trained
 
     config = json.loads(Path(config_path).read_text())
-    model = algorithm_class(config["algo"]).load(Path(config_path).with_suffix(".zip"),
-                                                 device="cpu")  # fmt: skip
+    model = load_trained(config["algo"], Path(config_path).with_suffix(".zip"))
 
     def act(obs: Any) -> Any:
         return model.predict(obs, deterministic=True)[0]

@@ -165,9 +165,9 @@ def _run_simulate(args: argparse.Namespace) -> int:
         env_kwargs = {**env_options(reference), **env_kwargs}
         policy = open_loop_policy(env_actions(reference))
     elif policy.endswith(".zip"):
-        from baselines.train import algorithm_class
+        from baselines.train import load_trained
 
-        model = algorithm_class(args.algo).load(policy, device="cpu")
+        model = load_trained(args.algo, policy)
         policy = lambda obs: model.predict(obs, deterministic=True)[0]  # noqa: E731
     elif policy != "random":
         policy = open_loop_policy(load_actions(Path(policy)))

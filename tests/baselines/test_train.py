@@ -11,7 +11,7 @@ import pytest
 
 from baselines.cli import add_train_parser
 from baselines.hyperparameters import get_hyperparameters
-from baselines.train import plot_training, run_name
+from baselines.train import load_trained, plot_training, run_name
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 TINY = {"policy_kwargs": {"net_arch": [16, 16]}}
@@ -85,6 +85,20 @@ def test_train_sac_smoke_through_the_cli(tmp_path: Path, capsys: pytest.CaptureF
     config = _check_outputs(tmp_path / f"{run_name(MANIPULATOR, 'time', 'SAC', 3)}.zip",
                             "SAC", 1000)  # fmt: skip
     assert config["num_envs"] == 1 and config["num_episodes"] == 2
+
+
+def test_load_trained_keeps_n_step_returns_without_the_false_warning(tmp_path: Path) -> None:
+    import warnings
+
+    from stable_baselines3 import SAC
+
+    SAC("MlpPolicy", "Pendulum-v1", n_steps=3, buffer_size=100, device="cpu").save(
+        tmp_path / "sac")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # any warning left on load fails the test
+        model = load_trained("sac", tmp_path / "sac.zip")
+    assert model.n_steps == 3
+    assert model.replay_buffer.n_steps == 3 and model.replay_buffer.gamma == model.gamma
 
 
 def test_cli_rejects_unknown_combinations() -> None:
