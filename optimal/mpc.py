@@ -84,7 +84,8 @@ the goal within this fraction of the task's success tolerances."""
 
 NLP_CACHE_SIZE = 400
 """Fixed-pattern NLPs a controller keeps (least recently used dropped). Each takes about 11 MB
-at 120 intervals (the 20-start manipulator evaluation's process grew to 4.9 GB).
+at 120 intervals (the 20-start manipulator evaluation's process grew to 4.9 GB), a robot one
+about 30 MB once solved (so up to ~12 GB; optimal/README.md, "Memory under a mismatch").
 Building one costs 0.5-0.8 s at 120 intervals and its first solve another 0.2 s (CasADi's
 expand); a warm-started re-solve of a kept one about 0.1 s. Episodes from nearby starts visit
 the same (intervals, pattern) keys, so from the second episode on most steps reuse an NLP."""
