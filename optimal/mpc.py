@@ -93,7 +93,7 @@ the same (intervals, pattern) keys, so from the second episode on most steps reu
 NEIGHBOUR_WINDOW = 3
 """The neighbouring-pattern fallback tries only the moves that change one of the next this-many
 intervals: a measured state off the plan puts the imminent mode in doubt, not a switch seconds
-ahead. All neighbours of a robot plan (3 contacts) were 20-27 new NLPs, 30-50 s per fallback."""
+ahead. All neighbours of a robot plan (3 contacts) are 20-27 new NLPs, 30-50 s per fallback."""
 
 MAX_EXTRA_STEPS = 3
 """On the env's grid, a time-optimal re-plan that cannot reach the goal in the env steps left

@@ -84,7 +84,7 @@ DIFF_DRIVE_ENV_ID = "mdi_envs/DiffDriveRobot-v0"
 
 MANIPULATOR_TIME_UNIT_TORQUE = 1.6
 """[N m] The manipulator's units: time t0 = sqrt(1 kg m^2 / tau_max) * sqrt(this / 1 N m)
-(1 s at 1.6 N m, the bound the optimizer was first run with), velocity 1/t0, impulse
+(1 s at 1.6 N m), velocity 1/t0, impulse
 1 kg m^2 / t0. They follow the physics' scaling (t ~ tau_max^(-1/2)), so the nondimensional NLP,
 its continuation path and its local optimum do not depend on the torque bound."""
 

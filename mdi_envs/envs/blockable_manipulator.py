@@ -104,7 +104,8 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
     impulsive, set-valued control. The task (Yunt & Glocker 2007, section 3.1) is to swing the
     arm from alpha = beta = 0 at rest to alpha = beta = pi at rest as fast as possible. The
     optimal maneuver uses the brake to store and release the second link's motion; the
-    optimal-control reference takes 4.53 s (``optimal.load_reference("manipulator_time")``).
+    shipped optimal-control reference takes 4.256 s (``optimal.load_reference("manipulator_time")``;
+    the paper reports 4.53 s).
 
     ## Action Space
     `action_mode="box"` (default): `Box(-1, 1, (2,), float32)`, SB3 PPO/SAC train on it as is.

@@ -2,7 +2,7 @@
 
 This is the one place where impulses and complementarity variables are mapped to each other
 (solvers speak ``M, q, z, w``; mechanics speaks mass matrix and coordinates). Notation of
-DESIGN.md section 2, per step of length dt:
+the documentation's Theory page (docs/theory.md), per step of length dt:
 
     q_M = q + dt/2 u
     M(q_M) (u+ - u) = (h(q_M, u) + theta J (u+ - u) + B tau) dt + W P,   J = dh/du(q_M, u)

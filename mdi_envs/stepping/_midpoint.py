@@ -6,10 +6,10 @@ tuples, and with every intermediate a local value the compiler evaluates shared 
 once (the manipulator's sin(beta - alpha) enters h five times: once for h, four times for the
 central differences of dh/du) and keeps the small matrix algebra in registers. Results go to
 fixed offsets of one flat scratch buffer, written once, never through array views: each view
-costs reference counting on every step, which was most of a free step's time. The source is
+costs reference counting on every step. The source is
 generated per model (sizes and flags are compile-time constants), like
 ``_kernel._make_carver``. The manipulator's free step in-kernel: ``python -m benchmarks.engine
---output /tmp/bench --quick``, scene "released" (about 0.1 us; 0.4 us before this module).
+--output /tmp/bench --quick``, scene "released".
 """
 
 from __future__ import annotations
@@ -203,7 +203,7 @@ def make_free_motion(model: type[ModelDefinition], reuse_constant_mass: bool) ->
     ``MOTION_UNDER_RESOLVED`` when the step is too coarse for the linearization (the symmetric
     part of M_theta does not exceed 0.9 M: dt |u| is no longer small against the configuration
     scale, e.g. an arm turning about a radian per step; the step is still taken with M_theta,
-    and reports ``INACCURATE``: dropping J there was tried and diverges to inf, while M_theta
+    and reports ``INACCURATE``: dropping J there diverges to inf, while M_theta
     near singular can multiply the energy); ``MOTION_SINGULAR`` if the matrix cannot be
     inverted.
 

@@ -3,7 +3,7 @@
 For models with ``CONTACT_DIMENSION == 3`` whose contacts are always closed and whose normal
 forces are not velocity constraints but follow from a load balance, ``N = N0 + K F`` as a linear
 function of the friction forces F (``model.normal_loads(p)``; the differential-drive robot,
-paper section 3.2, set I_NC). Per step of length dt (notation of DESIGN.md section 2):
+paper section 3.2, set I_NC). Per step of length dt (notation of docs/theory.md):
 
     q_M = q + dt/2 u
     u_free = u + M^-1 (h(q_M, u) + B tau) dt

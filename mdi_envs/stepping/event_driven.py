@@ -1,6 +1,6 @@
 """Event-driven reference integrator: high-order smooth phases, impact laws at events.
 
-Method (DESIGN.md section 2, "Event-driven reference integrator"). Between events the motion is
+Method (docs/theory.md, "Event-driven reference integrator"). Between events the motion is
 smooth and integrated by ``scipy.integrate.solve_ivp`` (DOP853 by default, rtol 1e-10, atol
 1e-12) with dense output and event location. A phase has a fixed set of active constraints: the
 engaged (ideal) brakes and the contacts that stay closed, rows ``W_a`` (r, n), all constant in q

@@ -88,8 +88,8 @@ class MoreauJeanStepper:
             quadratic model over the step: exact for linear gaps under constant forces (the
             ball and the block: grid states equal the closed form to rounding); a contact the
             model leaves open at t* falls back to the midpoint rule. Up to 3 extra solves per
-            impact step. Off by default (DESIGN.md's scheme); models with contacts and without
-            brakes only.
+            impact step. Off by default (the midpoint scheme of docs/theory.md); models with
+            contacts and without brakes only.
 
     Example:
         >>> from mdi_envs.mechanics.models.bouncing_ball import BouncingBall

@@ -1,4 +1,4 @@
-"""Moreau-Jean stepping of the bouncing ball against its closed forms (DESIGN.md section 2).
+"""Moreau-Jean stepping of the bouncing ball against its closed forms (docs/theory.md).
 
 The ball is dropped from rest at height h0 above contact (gap g = y - r = h0). Closed forms with
 v1 = sqrt(2 g h0): first impact at t1 = sqrt(2 h0 / g), then impacts spaced 2 eps^k v1 / g,
@@ -259,7 +259,7 @@ def test_grid_energy_increase_is_at_most_second_order(
     ),
 )
 def test_design_energy_never_increases(make_stepper: Callable[..., MoreauJeanStepper]) -> None:
-    """DESIGN.md section 2: "with eps <= 1 and no control the energy never increases".
+    """The textbook property "with eps <= 1 and no control the energy never increases".
 
     FAILS (reported): default ball, dt = 1e-3, dropped from rest at h0 = 1 m. At step 4061
     (t = 4.061 s, in the Zeno phase) the state is y - r = -2.31e-6 m, y' = +2.60e-3 m/s:

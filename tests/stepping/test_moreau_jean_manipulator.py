@@ -316,7 +316,7 @@ def test_free_energy_error_per_step_is_second_order(make_stepper: Stepper) -> No
         energy = np.array([kinetic(a, b) for a, b in zip(qs, us, strict=True)])
         increases.append(np.diff(energy).max())
         drifts.append(np.abs(energy - energy[0]).max())
-    assert increases[0] > 0.0  # it does gain energy at times (see the DESIGN test below)
+    assert increases[0] > 0.0  # it does gain energy at times (see the energy test below)
     increase_ratios = np.array(increases[:-1]) / np.array(increases[1:])
     assert np.all((increase_ratios > 7.0) & (increase_ratios < 9.0)), increases
     drift_ratios = np.array(drifts[:-1]) / np.array(drifts[1:])
@@ -332,7 +332,7 @@ def test_free_energy_error_per_step_is_second_order(make_stepper: Stepper) -> No
     ),
 )
 def test_design_energy_never_increases(make_stepper: Stepper) -> None:
-    """DESIGN.md section 2: "with eps <= 1 and no control the energy never increases".
+    """The textbook property "with eps <= 1 and no control the energy never increases".
 
     FAILS (reported): tau = 0, brake released, dt = 1e-3, q = (0.3, 1.2), u = (1.9, 0.3):
     679 of the first 1000 free steps gain energy, by up to 1.5e-8 J (T = 2.60 J). The

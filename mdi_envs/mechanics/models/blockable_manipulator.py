@@ -37,7 +37,7 @@ class BlockableManipulatorParameters:
     """Parameters of the manipulator, validated on construction.
 
     Attributes:
-        link1_mass: [kg] 1.0, DESIGN.md's default uniform rod.
+        link1_mass: [kg] 1.0, a uniform rod.
         link1_length: [m] 1.0, idem.
         link2_mass: [kg] 1.0, idem.
         link2_length: [m] 1.0, idem.
