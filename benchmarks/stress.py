@@ -15,7 +15,7 @@ stdout; exits with 1 if any case fails. Families of cases (issue 7, part 3):
    10^5 steps under full motor torque;
 3. ``dt_sweep``: dt from 1e-6 to 1e-1 s on every model over a fixed horizon;
 4. ``mu_sweep``: friction coefficients 0 ... 2 on the slope and on the robot;
-5. ``overdrive``: torques 10x, 100x, 1000x the task bounds on the manipulator and the robot;
+5. ``overdrive``: torques 10x, 100x, 1000x the maneuver bounds on the manipulator and the robot;
 6. ``lcp``: degenerate, rank-deficient and ill-conditioned LCPs (and the Siconos peer files)
    given straight to ``solve_lcp`` with every method;
 7. ``long_horizon``: energy, momentum and brake-constraint drift over 10^6 manipulator steps
@@ -55,6 +55,7 @@ from benchmarks import report
 from benchmarks.problems import peer_data_dir, peer_lcp_problems
 from benchmarks.stress_report import Criterion, at_least, at_most, markdown_report, plot_margins
 from benchmarks.timing import Progress, load_average, machine_info
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
 from mdi_envs.mechanics.models import BlockableManipulator, BouncingBall, SlidingBlock
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
 from mdi_envs.solvers.lcp import LCP_METHODS, lcp_residual, solve_lcp
@@ -62,7 +63,6 @@ from mdi_envs.solvers.status import SolverStatus
 from mdi_envs.stepping import MoreauJeanStepper
 from mdi_envs.stepping._kernel import INFO_STATUS
 from mdi_envs.stepping._spatial_kernel import INFO_LIFTED_CONTACTS, INFO_MODE
-from mdi_envs.tasks import DIFF_DRIVE_TASK, MANIPULATOR_TASK
 
 FloatArray = np.ndarray
 
@@ -115,7 +115,7 @@ class StressConfig:
         dt_max_calls: most ``step_batch`` calls (recorded states) per dt-sweep run.
         block_mu_grid: friction coefficients on the slope (plus tan(theta) (1 -+ 1e-3)).
         robot_mu_grid: friction coefficients of the robot's wheels and stick.
-        overdrive_factors: multiples of the task's torque bound.
+        overdrive_factors: multiples of the maneuver's torque bound.
         overdrive_horizon: simulated time of the overdrive runs [s].
         long_steps: steps of the manipulator's long run. long_stride: substeps per record.
         robot_long_steps: steps of the robot's long roll.
@@ -583,7 +583,7 @@ def brake_toggle_cases(config: StressConfig, steppers: Steppers, log: Callable[[
                        ) -> list[dict[str, Any]]:  # fmt: skip
     """The ideal brake engaged on even steps and released on odd ones, at full motor torque.
 
-    Manipulator from rest at alpha = beta = 0, dt = 0.01 s, |tau| = the task's max_torque. One
+    Manipulator from rest at alpha = beta = 0, dt = 0.01 s, |tau| = the maneuver's max_torque. One
     copy per torque pattern: constant +max (spins up for the whole run), bang-bang (sign flips
     every second) and a random sign every step (seeded). Criteria:
 
@@ -595,7 +595,7 @@ def brake_toggle_cases(config: StressConfig, steppers: Steppers, log: Callable[[
     """
     st = steppers.get("manipulator", MANIPULATOR_TIME_STEP)
     start = time.perf_counter()
-    steps, tau_max = config.toggle_steps, MANIPULATOR_TASK.max_torque
+    steps, tau_max = config.toggle_steps, MANIPULATOR_MANEUVER.max_torque
     k = np.arange(steps)
     patterns = {
         "+max": np.full(steps, tau_max),
@@ -916,7 +916,7 @@ def _robot_mu_cases(config: StressConfig, steppers: Steppers, log: Callable[[str
 # --------------------------------------------------------------------------- 5. overdrive
 def overdrive_cases(config: StressConfig, steppers: Steppers, log: Callable[[str], None]
                     ) -> list[dict[str, Any]]:  # fmt: skip
-    """Torques far beyond the task bounds for ``overdrive_horizon`` s (see the two helpers)."""
+    """Torques far beyond the maneuver bounds for ``overdrive_horizon`` s (see the two helpers)."""
     cases = []
     if "manipulator" in config.models:
         cases += _manipulator_overdrive(config, steppers, log)
@@ -937,7 +937,7 @@ def _manipulator_overdrive(config: StressConfig, steppers: Steppers,
     """
     st = steppers.get("manipulator", MANIPULATOR_TIME_STEP)
     steps = round(config.overdrive_horizon / MANIPULATOR_TIME_STEP)
-    tau_max = MANIPULATOR_TASK.max_torque
+    tau_max = MANIPULATOR_MANEUVER.max_torque
     k = np.arange(steps)
     brakes = {
         "released": np.zeros(steps),
@@ -983,7 +983,7 @@ def _robot_overdrive(config: StressConfig, steppers: Steppers, log: Callable[[st
     st = steppers.get("diff_drive", DIFF_DRIVE_TIME_STEP)
     p = st.parameters
     steps = round(config.overdrive_horizon / DIFF_DRIVE_TIME_STEP)
-    bound = DIFF_DRIVE_TASK.max_wheel_torque
+    bound = DIFF_DRIVE_MANEUVER.max_wheel_torque
     cases = []
     for factor in config.overdrive_factors:
         torques = factor * bound * np.array([[1.0, 1.0], [1.0, -1.0], [1.0, 0.0]])

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from mdi_envs._types import FloatArray
-from mdi_envs.tasks import DIFF_DRIVE_TASK, MANIPULATOR_TASK
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
 
 if TYPE_CHECKING:
     import pygame
@@ -304,7 +304,7 @@ def draw_manipulator(
     torque_fraction: float,
     parameters: BlockableManipulatorParameters,
     size: tuple[int, int] = (500, 500),
-    goal_q: Sequence[float] | None = MANIPULATOR_TASK.goal_q,
+    goal_q: Sequence[float] | None = MANIPULATOR_MANEUVER.goal_q,
 ) -> pygame.Surface:
     """Top view of the two-link manipulator, its brake, its motor torque and its goal pose.
 
@@ -319,7 +319,7 @@ def draw_manipulator(
         torque_fraction: motor torque as a fraction of its bound, in [-1, 1] (clipped).
         parameters: the model's parameters; the link lengths [m] set the drawing.
         size: canvas (width, height) [px].
-        goal_q: (2,) goal angles [rad] drawn as a faint ghost (default: the task's goal,
+        goal_q: (2,) goal angles [rad] drawn as a faint ghost (default: the maneuver's goal,
             alpha = beta = pi); None draws no ghost.
 
     Returns:
@@ -433,8 +433,8 @@ def draw_diff_drive(
 ) -> pygame.Surface:
     """Top view of the differential-drive robot on a 1 m grid, with its goal and its path.
 
-    The frame is fixed: it fits the task's start position and ``goal_pose`` with a 1 m margin
-    (for the paper's task, x in [-1, 3] and y in [-1, 6], widened to the canvas aspect), so an
+    The frame is fixed: it fits the maneuver's start position and ``goal_pose`` with a 1 m margin
+    (for the paper's maneuver, x in [-1, 3] and y in [-1, 6], widened to the canvas aspect), so an
     animation does not jump. The chassis points its nose to the stick (c, 0); the wheels are
     green while rolling and orange while slipping (grey when ``sliding`` is None); the goal pose
     is a faint ghost; the friction forces are purple arrows from the contact points, a wheel's
@@ -460,7 +460,7 @@ def draw_diff_drive(
     state = _state(q, ("x", "y", "phi", "psi_L", "psi_R"))
     goal = _state(goal_pose, ("x", "y", "phi"), "goal_pose")
     size = _check_size(size)
-    start = DIFF_DRIVE_TASK.initial_pose
+    start = DIFF_DRIVE_MANEUVER.initial_pose
     margin = DIFF_DRIVE_VIEW_MARGIN
     x_range = (min(start[0], goal[0]) - margin, max(start[0], goal[0]) + margin)
     y_range = (min(start[1], goal[1]) - margin, max(start[1], goal[1]) + margin)

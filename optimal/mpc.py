@@ -48,7 +48,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mdi_envs._types import FloatArray
-from mdi_envs.tasks import DIFF_DRIVE_TASK, MANIPULATOR_TASK, wrap_angle
+from mdi_envs.angles import wrap_angle
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
 from optimal.continuation import Schedule, solve_continuation
 from optimal.mode_search import ModeSolve, solve_with_modes
 from optimal.modes import ModePattern
@@ -80,7 +81,7 @@ STEP_MAX_ITERATIONS = 200
 GOAL_TOLERANCE_FRACTION = 0.5
 """Where the exact goal is infeasible from the measured state (an underactuated link off its
 plan by float32 rounding cannot be steered back within a fixed pattern), the re-solve asks for
-the goal within this fraction of the task's success tolerances."""
+the goal within this fraction of the maneuver's success tolerances."""
 
 NLP_CACHE_SIZE = 400
 """Fixed-pattern NLPs a controller keeps (least recently used dropped). Each takes about 11 MB
@@ -290,7 +291,7 @@ class ShrinkingHorizonMPC:
             angles = [math.atan2(observation[2 * i + 1], observation[2 * i]) for i in range(2)]
             q = np.array([p + wrap_angle(a - p) for a, p in zip(angles, predicted, strict=True)])
             return q, observation[4:6].copy()
-        goal = DIFF_DRIVE_TASK.goal_pose  # the robot: goal offset, heading error, body velocity
+        goal = DIFF_DRIVE_MANEUVER.goal_pose  # the robot: goal offset, heading error, body velocity
         heading = goal[2] + math.atan2(observation[3], observation[2])
         heading = predicted[2] + wrap_angle(heading - predicted[2])
         cos_phi, sin_phi = math.cos(heading), math.sin(heading)
@@ -434,12 +435,12 @@ class ShrinkingHorizonMPC:
             MAX_REPLAN_GROWTH * guess.final_time + self.time_step)
 
     def _goal_tolerances(self) -> tuple[float, float]:
-        """(q, u) tolerances: ``GOAL_TOLERANCE_FRACTION`` of the task's success box."""
+        """(q, u) tolerances: ``GOAL_TOLERANCE_FRACTION`` of the maneuver's success box."""
         if self.base.model.NUM_BRAKES:
-            task = MANIPULATOR_TASK
-            q_tol, u_tol = task.angle_tolerance, task.velocity_tolerance
+            maneuver = MANIPULATOR_MANEUVER
+            q_tol, u_tol = maneuver.angle_tolerance, maneuver.velocity_tolerance
         else:
-            robot = DIFF_DRIVE_TASK
+            robot = DIFF_DRIVE_MANEUVER
             q_tol = min(robot.position_tolerance / math.sqrt(2.0), robot.heading_tolerance)
             u_tol = min(robot.speed_tolerance / math.sqrt(2.0), robot.yaw_rate_tolerance)
         return GOAL_TOLERANCE_FRACTION * q_tol, GOAL_TOLERANCE_FRACTION * u_tol

@@ -1,10 +1,10 @@
 """The named optimal-control problems: the paper's three maneuvers and two small checks.
 
 * ``manipulator_time``: the blockable manipulator (paper section 3.1) from alpha = beta = 0 to
-  pi, at rest, time-optimally, |tau| <= ``MANIPULATOR_TASK.max_torque``.
+  pi, at rest, time-optimally, |tau| <= ``MANIPULATOR_MANEUVER.max_torque``.
 * ``diff_drive_time``: the differential-drive robot's maneuver B (section 3.2), time-optimal.
 * ``diff_drive_effort``: maneuver A, effort-optimal (integral of tau_L^2 + tau_R^2) at the
-  fixed t_f = ``DIFF_DRIVE_TASK.effort_final_time``.
+  fixed t_f = ``DIFF_DRIVE_MANEUVER.effort_final_time``.
 * ``double_integrator``: a unit mass from rest at 0 to rest at d = 1 m with |F| <= 1 N,
   time-optimal; the answer is bang-bang with T = 2 sqrt(d / a) = 2 s.
 * ``ball_drop``: the bouncing ball (eps = 0.5) dropped from 0.3 m, one impact, pushed
@@ -13,7 +13,7 @@
   the simulator's (the horizontal force does not touch it), the horizontal one the minimum-
   effort double integrator's (a force falling linearly in time).
 
-Start, goal and bounds come from ``mdi_envs.tasks``; nothing here restates a model formula.
+Start, goal and bounds come from ``mdi_envs.maneuvers``; nothing here restates a model formula.
 """
 
 from __future__ import annotations
@@ -22,11 +22,11 @@ import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
 from mdi_envs.mechanics.models.base import ModelDefinition
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulator
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBall, BouncingBallParameters
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
-from mdi_envs.tasks import DIFF_DRIVE_TASK, MANIPULATOR_TASK
 from optimal.transcription import OptimalControlProblem
 
 
@@ -94,21 +94,21 @@ MANIPULATOR_GUESS_TIME = 4.53
 
 def _manipulator_time(num_intervals: int = 120, guess_time: float = MANIPULATOR_GUESS_TIME
                       ) -> OptimalControlProblem:
-    task = MANIPULATOR_TASK
-    time_unit = math.sqrt(MANIPULATOR_TIME_UNIT_TORQUE / task.max_torque)
+    maneuver = MANIPULATOR_MANEUVER
+    time_unit = math.sqrt(MANIPULATOR_TIME_UNIT_TORQUE / maneuver.max_torque)
     return OptimalControlProblem(
         name="manipulator_time",
         model=BlockableManipulator,
         num_intervals=num_intervals,
-        initial_q=task.initial_q,
+        initial_q=maneuver.initial_q,
         initial_u=(0.0, 0.0),
-        goal_q=dict(enumerate(task.goal_q)),
+        goal_q=dict(enumerate(maneuver.goal_q)),
         goal_u={0: 0.0, 1: 0.0},
-        torque_bound=task.max_torque,
+        torque_bound=maneuver.max_torque,
         cost="time",
         final_time=guess_time * time_unit,
         final_time_bounds=(0.5 * time_unit, 20.0 * time_unit),
-        guess_final_q=task.goal_q,
+        guess_final_q=maneuver.goal_q,
         impulse_scale=1.0 / time_unit,
         velocity_scale=1.0 / time_unit,
         time_scale=guess_time * time_unit,
@@ -124,11 +124,12 @@ random stick-slip pattern solved with its modes fixed did not converge (500 iter
 
 
 def _diff_drive(cost: str, num_intervals: int = 100) -> OptimalControlProblem:
-    task = DIFF_DRIVE_TASK
+    maneuver = DIFF_DRIVE_MANEUVER
     parameters = DiffDriveRobot.Parameters()  # type: ignore[attr-defined]
-    weight_impulse = parameters.mass * parameters.gravity * task.effort_final_time / num_intervals
-    start = (*task.initial_pose, 0.0, 0.0)
-    end = (*task.goal_pose, 0.0, 0.0)
+    weight_impulse = (parameters.mass * parameters.gravity * maneuver.effort_final_time
+                      / num_intervals)
+    start = (*maneuver.initial_pose, 0.0, 0.0)
+    end = (*maneuver.goal_pose, 0.0, 0.0)
     effort = cost == "effort"
     return OptimalControlProblem(
         name="diff_drive_effort" if effort else "diff_drive_time",
@@ -137,11 +138,11 @@ def _diff_drive(cost: str, num_intervals: int = 100) -> OptimalControlProblem:
         num_intervals=num_intervals,
         initial_q=start,
         initial_u=(0.0,) * 5,
-        goal_q=dict(enumerate(task.goal_pose)),
+        goal_q=dict(enumerate(maneuver.goal_pose)),
         goal_u=dict.fromkeys(range(5), 0.0),
-        torque_bound=task.max_wheel_torque,
+        torque_bound=maneuver.max_wheel_torque,
         cost="effort" if effort else "time",
-        final_time=task.effort_final_time,
+        final_time=maneuver.effort_final_time,
         final_time_bounds=(0.5, 20.0),
         guess_final_q=end,
         guess_bend_scale=ROBOT_GUESS_BEND,
@@ -151,7 +152,7 @@ def _diff_drive(cost: str, num_intervals: int = 100) -> OptimalControlProblem:
         env_kwargs=(("task", "effort" if effort else "time"),),
         description=(
             "differential drive, maneuver A: (0, 0, 0) -> (2, 5, -pi/2) at rest, "
-            f"effort-optimal at t_f = {task.effort_final_time} s" if effort else
+            f"effort-optimal at t_f = {maneuver.effort_final_time} s" if effort else
             "differential drive, maneuver B: (0, 0, 0) -> (2, 5, -pi/2) at rest, time-optimal"
         ),
     )

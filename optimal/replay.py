@@ -3,8 +3,8 @@
 The inputs tau_k and brake commands of each interval are held (zero-order hold) and fed to
 ``MoreauJeanStepper`` -- the engine the environments step -- at the reference's own time step h
 and again at h/10 (each control held for 10 substeps). Reported: the final-state error against
-the reference's last grid point, and whether the replayed end state meets the task's success
-tolerances (``mdi_envs.tasks``).
+the reference's last grid point, and whether the replayed end state meets the maneuver's success
+tolerances (``mdi_envs.maneuvers``).
 """
 
 from __future__ import annotations
@@ -15,8 +15,9 @@ from typing import Any
 import numpy as np
 
 from mdi_envs._types import FloatArray
+from mdi_envs.angles import wrap_angle
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
 from mdi_envs.stepping import MoreauJeanStepper
-from mdi_envs.tasks import DIFF_DRIVE_TASK, MANIPULATOR_TASK, wrap_angle
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
 
@@ -29,8 +30,8 @@ class ReplayReport:
         substeps: simulator steps per reference interval (1 or 10).
         time_step: the simulator's dt [s].
         state_error: max |(q, u)_replay(t_f) - (q, u)_reference(t_f)| [rad, m, rad/s, m/s].
-        goal_errors: the task's error measures at the replayed end state (see ``goal_errors``).
-        reaches_goal: every goal error within the task's tolerance.
+        goal_errors: the maneuver's error measures at the replayed end state (see ``goal_errors``).
+        reaches_goal: every goal error within the maneuver's tolerance.
     """
 
     substeps: int
@@ -45,20 +46,20 @@ class ReplayReport:
 
 
 def goal_errors(name: str, q: FloatArray, u: FloatArray) -> tuple[dict[str, float], bool]:
-    """The task's error measures at the end state (q, u), and whether all are in tolerance.
+    """The maneuver's error measures at the end state (q, u), and whether all are in tolerance.
 
     Manipulator: wrapped angle errors [rad] and angular speeds [rad/s]. Robot: position error
     [m], wrapped heading error [rad], chassis speed [m/s], yaw rate [rad/s]. Other problems:
     the distance to their imposed goal coordinates and velocities, tolerance 1e-6.
     """
     if name.startswith("manipulator"):
-        task = MANIPULATOR_TASK
-        angle = max(abs(wrap_angle(float(q[i] - task.goal_q[i]))) for i in range(2))
+        maneuver = MANIPULATOR_MANEUVER
+        angle = max(abs(wrap_angle(float(q[i] - maneuver.goal_q[i]))) for i in range(2))
         speed = float(np.max(np.abs(u)))
         errors = {"angle": angle, "angular_speed": speed}
-        return errors, angle <= task.angle_tolerance and speed <= task.velocity_tolerance
+        return errors, angle <= maneuver.angle_tolerance and speed <= maneuver.velocity_tolerance
     if name.startswith("diff_drive"):
-        robot = DIFF_DRIVE_TASK
+        robot = DIFF_DRIVE_MANEUVER
         errors = {
             "position": float(np.hypot(q[0] - robot.goal_pose[0], q[1] - robot.goal_pose[1])),
             "heading": abs(wrap_angle(float(q[2] - robot.goal_pose[2]))),

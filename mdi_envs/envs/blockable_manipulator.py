@@ -11,11 +11,12 @@ import numpy as np
 from gymnasium import spaces
 
 from mdi_envs._types import FloatArray
+from mdi_envs.angles import cos_sin, wrap_angle
 from mdi_envs.envs._actions import TorqueBrakeActions
 from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
+from mdi_envs.maneuvers import MANIPULATOR_MANEUVER
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulator
 from mdi_envs.mechanics.parameters import require_positive
-from mdi_envs.tasks import MANIPULATOR_TASK, cos_sin, wrap_angle
 
 VELOCITY_WEIGHT = 0.3  # [s] weight of the speeds in the goal distance (rad/s -> rad)
 
@@ -29,7 +30,7 @@ class BlockableManipulatorTask(MoreauJeanTask):
     def __init__(
         self,
         *,
-        max_torque: float = MANIPULATOR_TASK.max_torque,
+        max_torque: float = MANIPULATOR_MANEUVER.max_torque,
         max_brake_torque: float = 50.0,
         action_mode: str = "box",
         time_step: float = 0.01,
@@ -54,12 +55,12 @@ class BlockableManipulatorTask(MoreauJeanTask):
 
     def nominal_start(self) -> FloatArray:
         """Rest at alpha = beta = 0."""
-        return np.array([*MANIPULATOR_TASK.initial_q, 0.0, 0.0])
+        return np.array([*MANIPULATOR_MANEUVER.initial_q, 0.0, 0.0])
 
     def constants(self) -> FloatArray:
         """(goal alpha, goal beta, angle tol, speed tol, velocity weight, max brake torque)."""
-        task = MANIPULATOR_TASK
-        return np.array([*task.goal_q, task.angle_tolerance, task.velocity_tolerance,
+        maneuver = MANIPULATOR_MANEUVER
+        return np.array([*maneuver.goal_q, maneuver.angle_tolerance, maneuver.velocity_tolerance,
                          VELOCITY_WEIGHT, self.max_brake_torque])  # fmt: skip
 
     @staticmethod
@@ -144,7 +145,7 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
 
     ## Episode End
     1. Termination: success, `info["is_success"]`: both wrapped angle errors <= 0.05 rad and
-       both speeds <= 0.1 rad/s (``mdi_envs.tasks.MANIPULATOR_TASK``).
+       both speeds <= 0.1 rad/s (``mdi_envs.maneuvers.MANIPULATOR_MANEUVER``).
     2. Truncation: 500 steps (10 s) via `max_episode_steps`.
     A solve that does not converge is reported in `info["solver_status"]` (a
     ``SolverStatus`` code, 0 = converged); a non-finite state raises RuntimeError.
@@ -162,7 +163,7 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
     | parameter         | type  | default | description                                    |
     |-------------------|-------|---------|------------------------------------------------|
     | action_mode       | str   | "box"   | "box", "hybrid" or "brake_force"               |
-    | max_torque        | float | task    | motor torque bound [N m] (calibrated, tasks.py) |
+    | max_torque        | float | 0.84302 | motor torque bound [N m] (``mdi_envs.maneuvers``) |
     | max_brake_torque  | float | 50.0    | brake bound at action 1 in "brake_force" [N m] |
     | time_step         | float | 0.01    | physics step [s]                               |
     | frame_skip        | int   | 2       | physics steps per env step                     |

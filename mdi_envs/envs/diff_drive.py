@@ -12,12 +12,13 @@ import numpy as np
 from gymnasium import spaces
 
 from mdi_envs._types import FloatArray
+from mdi_envs.angles import cos_sin, wrap_angle
 from mdi_envs.envs._actions import TorqueBrakeActions
 from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
 from mdi_envs.mechanics.parameters import require_positive
 from mdi_envs.stepping._spatial_kernel import INFO_LIFTED_CONTACTS, INFO_MODE, INFO_RESIDUAL
-from mdi_envs.tasks import DIFF_DRIVE_TASK, cos_sin, wrap_angle
 
 HEADING_WEIGHT = 0.5  # [m/rad] weight of the heading error in the goal distance
 VELOCITY_WEIGHT = 0.5  # [s] weight of the chassis speed in the goal distance
@@ -38,7 +39,7 @@ class DiffDriveRobotTask(MoreauJeanTask):
         self,
         *,
         task: str = "time",
-        max_wheel_torque: float = DIFF_DRIVE_TASK.max_wheel_torque,
+        max_wheel_torque: float = DIFF_DRIVE_MANEUVER.max_wheel_torque,
         time_step: float = 0.01,
         frame_skip: int = 5,
         reset_noise_scale: float = 0.01,
@@ -47,7 +48,7 @@ class DiffDriveRobotTask(MoreauJeanTask):
         if task not in self.OBJECTIVE_OPTIONS:
             raise ValueError(f"task must be one of {self.OBJECTIVE_OPTIONS}, got {task!r}")
         super().__init__(time_step=time_step, frame_skip=frame_skip, objective=task,
-                         final_time=DIFF_DRIVE_TASK.effort_final_time,
+                         final_time=DIFF_DRIVE_MANEUVER.effort_final_time,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
         self.max_wheel_torque = require_positive("max_wheel_torque", max_wheel_torque)
         # wheel torques tau_L, tau_R [N m] from the normalised Box action
@@ -64,11 +65,11 @@ class DiffDriveRobotTask(MoreauJeanTask):
 
     def nominal_start(self) -> FloatArray:
         """Rest at the origin heading +x (wheel angles 0)."""
-        return np.concatenate([DIFF_DRIVE_TASK.initial_pose, np.zeros(7)])
+        return np.concatenate([DIFF_DRIVE_MANEUVER.initial_pose, np.zeros(7)])
 
     def constants(self) -> FloatArray:
         """(goal x, y, phi, the four tolerances, the three distance weights)."""
-        t = DIFF_DRIVE_TASK
+        t = DIFF_DRIVE_MANEUVER
         return np.array([*t.goal_pose, t.position_tolerance, t.heading_tolerance,
                          t.speed_tolerance, t.yaw_rate_tolerance, HEADING_WEIGHT,
                          VELOCITY_WEIGHT, YAW_RATE_WEIGHT])  # fmt: skip
@@ -158,7 +159,7 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
 
     ## Episode End
     1. Termination: "time": success (`info["is_success"]`: position within 0.05 m, heading
-       within 0.05 rad, speed <= 0.05 m/s, yaw rate <= 0.1 rad/s; ``mdi_envs.tasks``).
+       within 0.05 rad, speed <= 0.05 m/s, yaw rate <= 0.1 rad/s; ``mdi_envs.maneuvers``).
        "effort": when the 4.05 s horizon ends (81 steps); `is_success` then says whether
        the goal was reached.
     2. Truncation: 200 steps (10 s) via `max_episode_steps`.
@@ -177,7 +178,7 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     | parameter         | type  | default | description                                      |
     |-------------------|-------|---------|--------------------------------------------------|
     | task              | str   | "time"  | "time" (maneuver B) or "effort" (maneuver A)     |
-    | max_wheel_torque  | float | task    | wheel torque bound [N m] (``mdi_envs.tasks``)    |
+    | max_wheel_torque  | float | 3.0     | wheel torque bound [N m] (``mdi_envs.maneuvers``) |
     | time_step         | float | 0.01    | physics step [s]                                 |
     | frame_skip        | int   | 5       | physics steps per env step                       |
     | parameters        | DiffDriveParameters | defaults | mass, geometry, friction       |
@@ -219,7 +220,7 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
         slip = (rows @ self.state.u[0]).reshape(3, 3)[:, 1:]
         sliding = np.hypot(slip[:, 0], slip[:, 1]) > SLIDING_SPEED
         impulses = self.state.impulses[0].reshape(3, 3)
-        return draw_diff_drive(q, self.task.parameters, DIFF_DRIVE_TASK.goal_pose,
+        return draw_diff_drive(q, self.task.parameters, DIFF_DRIVE_MANEUVER.goal_pose,
                                contact_forces=impulses[:, 1:] / self.task.stepper.time_step,
                                sliding=sliding, trail=self._trail)  # fmt: skip
 

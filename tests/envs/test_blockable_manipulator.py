@@ -11,7 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import mdi_envs  # noqa: F401 - registers the ids
-from mdi_envs.tasks import MANIPULATOR_TASK
+from mdi_envs.maneuvers import MANIPULATOR_MANEUVER
 
 ENV_ID = "mdi_envs/BlockableManipulator-v0"
 
@@ -78,7 +78,7 @@ def test_brake_force_mode_is_a_tresca_element() -> None:
 def test_reaching_the_goal_at_rest_terminates_with_success() -> None:
     env = make(shaping_weight=0.0)
     env.reset(seed=0)
-    env.unwrapped.set_state(np.array(MANIPULATOR_TASK.goal_q) + 0.01, np.zeros(2))
+    env.unwrapped.set_state(np.array(MANIPULATOR_MANEUVER.goal_q) + 0.01, np.zeros(2))
     obs, reward, terminated, truncated, info = env.step(np.array([0.0, 1.0], np.float32))
     assert terminated and not truncated and info["is_success"]
     assert reward == pytest.approx(-env.unwrapped.dt, abs=1e-15)

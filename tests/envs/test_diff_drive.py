@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import mdi_envs  # noqa: F401 - registers the ids
-from mdi_envs.tasks import DIFF_DRIVE_TASK
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
 
 ENV_ID = "mdi_envs/DiffDriveRobot-v0"
 
@@ -45,15 +45,15 @@ def test_full_opposite_torques_spin_and_slip() -> None:
 def test_effort_task_ends_at_the_fixed_horizon() -> None:
     env = make(task="effort")
     env.reset(seed=0)
-    num_steps = round(DIFF_DRIVE_TASK.effort_final_time / env.unwrapped.dt)
+    num_steps = round(DIFF_DRIVE_MANEUVER.effort_final_time / env.unwrapped.dt)
     for k in range(num_steps):
         obs, reward, terminated, truncated, info = env.step(np.array([0.2, 0.1], np.float32))
         assert obs[9] == pytest.approx((num_steps - k - 1) * env.unwrapped.dt, abs=1e-6)
         assert terminated == (k == num_steps - 1)
     assert info["reward_goal"] == pytest.approx(-10.0 * info["distance_to_goal"])
-    assert info["elapsed_time"] == pytest.approx(DIFF_DRIVE_TASK.effort_final_time)
-    assert info["effort"] == pytest.approx((0.04 + 0.01) * DIFF_DRIVE_TASK.max_wheel_torque**2
-                                           * DIFF_DRIVE_TASK.effort_final_time, rel=1e-6)
+    assert info["elapsed_time"] == pytest.approx(DIFF_DRIVE_MANEUVER.effort_final_time)
+    assert info["effort"] == pytest.approx((0.04 + 0.01) * DIFF_DRIVE_MANEUVER.max_wheel_torque**2
+                                           * DIFF_DRIVE_MANEUVER.effort_final_time, rel=1e-6)
 
 
 def test_effort_horizon_must_be_a_whole_number_of_steps() -> None:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from mdi_envs.tasks import cos_sin, wrap_angle
+from mdi_envs.angles import cos_sin, wrap_angle
 
 ANGLES = np.concatenate([np.random.default_rng(0).uniform(-1e3, 1e3, 500),
                          [0.0, -0.0, math.pi, -math.pi, 1e-300, 2.5e7]])  # fmt: skip

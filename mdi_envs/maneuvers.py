@@ -1,21 +1,18 @@
-"""The mission tasks, defined once: start and goal states, control bounds, success tolerances.
+"""The maneuvers, defined once: start and goal states, control bounds, success tolerances.
 
 The environments, the optimal-control references (``optimal/``) and the baselines all read these
 records, so a goal, a torque bound or a tolerance exists in exactly one place. The paper's
-published numbers (Yunt & Glocker, HSCC 2007) sit beside each task for comparison only.
+published numbers (Yunt & Glocker, HSCC 2007) sit beside each maneuver for comparison only.
 """
 
 from __future__ import annotations
 
-import cmath
 import math
 from dataclasses import dataclass
 
-from numba import njit
-
 
 @dataclass(frozen=True)
-class ManipulatorTask:
+class ManipulatorManeuver:
     """Blockable manipulator, paper section 3.1: from alpha = beta = 0 to pi, at rest, fastest.
 
     Attributes:
@@ -44,7 +41,7 @@ class ManipulatorTask:
 
 
 @dataclass(frozen=True)
-class DiffDriveTask:
+class DiffDriveManeuver:
     """Differential-drive robot, paper section 3.2: from rest at the origin to (2, 5, -pi/2).
 
     Maneuver A minimizes the effort (integral of tau_L^2 + tau_R^2) with the final time fixed;
@@ -79,38 +76,13 @@ class DiffDriveTask:
     paper_time_optimal: float = 4.03
 
 
-MANIPULATOR_TASK = ManipulatorTask()
-DIFF_DRIVE_TASK = DiffDriveTask()
-
-
-@njit(cache=True, inline="always")
-def wrap_angle(angle: float) -> float:
-    """``angle`` [rad] mapped to [-pi, pi] (compiled: also callable from the env kernels).
-
-    By floor rather than ``%`` (a libm fmod call, several times slower in the env kernels);
-    rounding can land on +-pi itself.
-    """
-    turns = math.floor((angle + math.pi) / (2.0 * math.pi))
-    return angle - 2.0 * math.pi * turns
-
-
-@njit(cache=True, inline="always")
-def cos_sin(angle: float) -> tuple[float, float]:
-    """(cos angle, sin angle) for ``angle`` [rad] in one libm call (compiled).
-
-    Through the complex exponential, which glibc evaluates with sincos: the values of
-    ``math.cos`` and ``math.sin`` (bitwise with glibc) in about half their time (the env
-    kernels' observations).
-    """
-    z = cmath.exp(complex(0.0, angle))
-    return z.real, z.imag
+MANIPULATOR_MANEUVER = ManipulatorManeuver()
+DIFF_DRIVE_MANEUVER = DiffDriveManeuver()
 
 
 __all__ = [
-    "DIFF_DRIVE_TASK",
-    "MANIPULATOR_TASK",
-    "cos_sin",
-    "DiffDriveTask",
-    "ManipulatorTask",
-    "wrap_angle",
+    "DIFF_DRIVE_MANEUVER",
+    "MANIPULATOR_MANEUVER",
+    "DiffDriveManeuver",
+    "ManipulatorManeuver",
 ]
