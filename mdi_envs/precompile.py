@@ -69,7 +69,7 @@ def compile_env(env_id: str, report: Callable[[str, float], None] | None = None)
             env.step(env.action_space.sample())
 
     def stepper() -> None:
-        stepper = single(variants[0]).task.stepper
+        stepper = single(variants[0]).scene.stepper
         n = stepper.num_dofs
         state = np.zeros(n)
         stepper.step(state, state, np.zeros(stepper.num_inputs))

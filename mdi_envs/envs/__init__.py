@@ -1,6 +1,6 @@
 """The Gymnasium environments (registered as ``mdi_envs/...`` by ``import mdi_envs``)."""
 
-from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
+from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanScene, MoreauJeanVectorEnv
 from mdi_envs.envs.blockable_manipulator import (
     BlockableManipulatorEnv,
     BlockableManipulatorVectorEnv,
@@ -17,7 +17,7 @@ __all__ = [
     "DiffDriveRobotEnv",
     "DiffDriveRobotVectorEnv",
     "MoreauJeanEnv",
-    "MoreauJeanTask",
+    "MoreauJeanScene",
     "MoreauJeanVectorEnv",
     "SlidingBlockEnv",
     "SlidingBlockVectorEnv",

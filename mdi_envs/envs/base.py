@@ -1,22 +1,22 @@
-"""The environment base classes: one batched task behind a single and a vector Gymnasium env.
+"""The environment base classes: one batched scene behind a single and a vector Gymnasium env.
 
 Everything scene-specific -- spaces, action decoding, observations, goal distance, success --
-lives in a ``MoreauJeanTask`` written once for a batch of N copies. ``MoreauJeanEnv`` runs it
+lives in a ``MoreauJeanScene`` written once for a batch of N copies. ``MoreauJeanEnv`` runs it
 with N = 1 and ``MoreauJeanVectorEnv`` with N = ``num_envs``; both advance the physics through
 the same compiled ``MoreauJeanStepper.step_batch`` call, so the vector env equals a
 ``SyncVectorEnv`` of the single env step for step. The reward is assembled here, the same for
-every task:
+every scene:
 
     reward = reward_objective + reward_shaping + reward_goal
     reward_objective = -dt                       (objective "time")
                      = -effort_weight sum(tau^2) dt   (objective "effort")
     reward_shaping   = gamma Phi(s') - Phi(s),   Phi = -shaping_weight * distance_to_goal,
                        with Phi(s') = 0 when the episode terminates (Ng et al. 1999: the optimal
-                       policy of the discounted task with discount gamma is unchanged)
+                       policy of the discounted problem with discount gamma is unchanged)
     reward_goal      = -goal_weight * distance_to_goal, once, when a fixed horizon ends.
 
 The per-copy scene functions (observation, goal distance, success) are plain Python on scalars
-and small arrays, compiled with numba into one batched kernel per task class, so that an
+and small arrays, compiled with numba into one batched kernel per scene class, so that an
 ``env.step`` costs one compiled call (action decoding, physics, rewards, observations and info)
 with six array arguments: the batch state lives in one flat buffer (``BatchState``).
 """
@@ -79,7 +79,7 @@ def build_parameters(parameters: Any, defaults: type[Any], **overrides: Any) -> 
     return dataclasses.replace(base, **changes) if changes else base
 
 
-class MoreauJeanTask:
+class MoreauJeanScene:
     """Scene logic of one environment family, batched over N copies.
 
     Subclasses set ``MODEL``, ``NUM_OBSERVATIONS`` and ``OBJECTIVE_OPTIONS``, the action coding
@@ -109,7 +109,7 @@ class MoreauJeanTask:
     single_observation_space: spaces.Space[Any]
     single_action_space: spaces.Space[Any]
     actions: TorqueBrakeActions
-    """The action coding (space, scaling, brake rule); set by each task's ``__init__``."""
+    """The action coding (space, scaling, brake rule); set by each scene's ``__init__``."""
 
     def __init__(
         self,
@@ -127,7 +127,7 @@ class MoreauJeanTask:
         shortcuts: StepShortcuts | None = None,
         locate_impacts: bool = False,
     ) -> None:
-        self._task_array_cache: FloatArray | None = None
+        self._settings_cache: FloatArray | None = None
         self._info_keys = BASE_INFO_KEYS + self.INFO_KEYS
         self._info_of = _info_builder(self._info_keys)
         _require(isinstance(frame_skip, (int, np.integer)) and frame_skip >= 1,
@@ -162,7 +162,7 @@ class MoreauJeanTask:
         self._take_kernels()
 
     def _take_kernels(self) -> None:
-        """Look up (or build) the compiled kernels of this task (see ``_compiled``)."""
+        """Look up (or build) the compiled kernels of this scene (see ``_compiled``)."""
         self._kernels = _compiled(self)
         self._advance_kernel = self._kernels[0]
 
@@ -177,30 +177,30 @@ class MoreauJeanTask:
         self._take_kernels()
 
     @property
-    def _task_array(self) -> FloatArray:
-        """Everything the compiled ``advance`` reads of the task, in one float64 array (copied
+    def _settings_array(self) -> FloatArray:
+        """Everything the compiled ``advance`` reads of the scene, in one float64 array (copied
         to the end of every ``BatchState`` buffer).
 
         (time_step, frame_skip, dt, horizon steps, effort_weight, goal_weight, shaping_weight,
         shaping_discount, action rule, max_torque, max_brake_torque), then the model's
         parameter record, then the scene constants ``c`` (see ``_compiled``).
         """
-        if self._task_array_cache is None:
+        if self._settings_cache is None:
             coding = self.actions
-            self._task_array_cache = np.array([
+            self._settings_cache = np.array([
                 self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
                 self.effort_weight, self.goal_weight, self.shaping_weight,
                 self.shaping_discount, coding.rule, coding.max_torque, coding.max_brake_torque,
                 *self.stepper.compiled_step_batch[1], *np.asarray(self.constants(), np.float64),
             ])  # fmt: skip
-        return self._task_array_cache
+        return self._settings_cache
 
     @property
     def _constants(self) -> FloatArray:
-        """The scene constants ``c`` (a view into ``_task_array``)."""
-        return self._task_array[SETTINGS_SIZE + len(self.stepper.compiled_step_batch[1]):]
+        """The scene constants ``c`` (a view into ``_settings_array``)."""
+        return self._settings_array[SETTINGS_SIZE + len(self.stepper.compiled_step_batch[1]):]
 
-    # -- scene-specific, implemented by each task ------------------------------------------
+    # -- scene-specific, implemented by each scene class ------------------------------------
     # The three static methods below are compiled by numba (nopython): plain arithmetic on
     # floats and 1-D float64 arrays, scene constants read from ``c`` (``self.constants()``).
     NUM_OBSERVATIONS: ClassVar[int]
@@ -217,7 +217,7 @@ class MoreauJeanTask:
 
     @staticmethod
     def success_one(q: Any, u: Any, c: Any) -> bool:
-        """Whether one copy is at the goal at rest within the task's tolerances."""
+        """Whether one copy is at the goal at rest within the maneuver's tolerances."""
         raise NotImplementedError
 
     def constants(self) -> FloatArray:
@@ -332,15 +332,15 @@ class MoreauJeanTask:
         state.potential[index] = -self.shaping_weight * distance
 
 
-def state_fields(task: MoreauJeanTask) -> tuple[tuple[str, int | None], ...]:
+def state_fields(scene: MoreauJeanScene) -> tuple[tuple[str, int | None], ...]:
     """(name, width) of the per-copy ``BatchState`` arrays inside its buffer, in order.
 
     Width w makes an (N, w) array, None an (N,) array (one number per copy).
     """
-    model, stepper = task.MODEL, task.stepper
+    model, stepper = scene.MODEL, scene.stepper
     return (("q", model.NUM_DOFS), ("u", model.NUM_DOFS), ("tau", model.NUM_INPUTS),
             ("brake", model.NUM_BRAKES), ("impulses", stepper.num_impulses),
-            ("physics", stepper.info_size), ("info", len(task.info_keys)),
+            ("physics", stepper.info_size), ("info", len(scene.info_keys)),
             ("elapsed_steps", None), ("effort", None), ("potential", None),
             ("terminated", None), ("reward", None))  # fmt: skip
 
@@ -360,10 +360,10 @@ class StateLayout(NamedTuple):
     num_observations: int
 
     @classmethod
-    def of(cls, task: MoreauJeanTask) -> StateLayout:
-        """The layout of ``task``'s states."""
-        floats, ints = task.stepper.compiled_step_batch[2]
-        return cls(state_fields(task), floats.size, ints.size, task.NUM_OBSERVATIONS)
+    def of(cls, scene: MoreauJeanScene) -> StateLayout:
+        """The layout of ``scene``'s states."""
+        floats, ints = scene.stepper.compiled_step_batch[2]
+        return cls(state_fields(scene), floats.size, ints.size, scene.NUM_OBSERVATIONS)
 
     def size(self, num_copies: int, num_settings: int) -> int:
         """float64 entries of the buffer of ``num_copies`` copies and ``num_settings`` settings."""
@@ -380,7 +380,7 @@ class BatchState:
     an env step passes it as one argument: N, the stepper's scratch (its int part read through
     an int64 view), the per-copy arrays of ``state_fields`` (C-contiguous float64, array after
     array), the float32 observations (a float32 view of ceil(N * NUM_OBSERVATIONS / 2) float64
-    entries) and last a copy of the task's settings (``MoreauJeanTask._task_array``). The same
+    entries) and last a copy of the scene's settings (``MoreauJeanScene._settings_array``). The same
     generated function carves the views here (numpy) and inside the kernels (numba). Assign
     into them (``state.q[i] = ...``), never rebind them.
 
@@ -409,10 +409,10 @@ class BatchState:
     reward: FloatArray
     obs: np.ndarray
 
-    def __init__(self, task: MoreauJeanTask, num_copies: int) -> None:
+    def __init__(self, scene: MoreauJeanScene, num_copies: int) -> None:
         self.num_copies = num_copies
-        self.layout = StateLayout.of(task)
-        settings = task._task_array
+        self.layout = StateLayout.of(scene)
+        settings = scene._settings_array
         self.buffer = np.zeros(self.layout.size(num_copies, settings.size))
         self.buffer[0] = num_copies
         self.buffer[self.buffer.size - settings.size:] = settings
@@ -433,32 +433,32 @@ class BatchState:
 
 
 class MoreauJeanEnv(gym.Env[Any, Any]):
-    """A single Gymnasium environment running one copy of a ``MoreauJeanTask``.
+    """A single Gymnasium environment running one copy of a ``MoreauJeanScene``.
 
-    Subclasses set ``TASK`` and ``metadata`` and implement ``_draw`` (rendering). Like
+    Subclasses set ``SCENE`` and ``metadata`` and implement ``_draw`` (rendering). Like
     Gymnasium's MuJoCo base, it exposes ``dt``, ``set_state(q, u)`` and the model state.
     """
 
-    TASK: ClassVar[type[MoreauJeanTask]]
+    SCENE: ClassVar[type[MoreauJeanScene]]
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
 
     def __init__(self, render_mode: str | None = None, **options: Any) -> None:
         _require(render_mode is None or render_mode in self.metadata["render_modes"],
                  f"render_mode must be one of {self.metadata['render_modes']} or None, got "
                  f"{render_mode!r}")  # fmt: skip
-        self.task = self.TASK(**options)
-        self.observation_space = self.task.single_observation_space
-        self.action_space = self.task.single_action_space
+        self.scene = self.SCENE(**options)
+        self.observation_space = self.scene.single_observation_space
+        self.action_space = self.scene.single_action_space
         self.render_mode = render_mode
-        self.metadata = {**self.metadata, "render_fps": max(1, round(1.0 / self.task.dt))}
-        self.state = BatchState(self.task, 1)
+        self.metadata = {**self.metadata, "render_fps": max(1, round(1.0 / self.scene.dt))}
+        self.state = BatchState(self.scene, 1)
         self._viewer: Any = None
         self._has_reset = False
 
     @property
     def dt(self) -> float:
         """Duration of one env step [s] (time_step * frame_skip)."""
-        return self.task.dt
+        return self.scene.dt
 
     @property
     def q(self) -> FloatArray:
@@ -472,7 +472,7 @@ class MoreauJeanEnv(gym.Env[Any, Any]):
 
     def set_state(self, q: Any, u: Any) -> None:
         """Overwrite the physical state; shapes (n,), finite values."""
-        n = self.task.MODEL.NUM_DOFS
+        n = self.scene.MODEL.NUM_DOFS
         for name, value in (("q", q), ("u", u)):
             array = np.asarray(value, dtype=np.float64)
             _require(array.shape == (n,), f"{name} must have shape ({n},), got {array.shape}")
@@ -480,25 +480,25 @@ class MoreauJeanEnv(gym.Env[Any, Any]):
         self.state.q[0] = q
         self.state.u[0] = u
         self.state.impulses[0] = 0.0  # no warm start from another state
-        self.task.update_potential(self.state, 0)
-        self.task.observe(self.state)
+        self.scene.update_potential(self.state, 0)
+        self.scene.observe(self.state)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Advance by ``dt``; see the class docstring for rewards and ``info``."""
         if not self._has_reset:
             raise gym.error.ResetNeeded("call reset() before step()")
         state = self.state
-        self.task.advance(state, action)
+        self.scene.advance(state, action)
         if self.render_mode == "human":
             self.render()
         return (state.obs[0].copy(), float(state.reward[0]), bool(state.terminated[0]), False,
-                self.task.info_dict(state))
+                self.scene.info_dict(state))
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[Any, dict[str, Any]]:  # fmt: skip
         """Start a new episode (start state drawn from ``self.np_random``)."""
         super().reset(seed=seed)
-        self.task.reset_copies(self.state, _FIRST_COPY, (self.np_random,))
+        self.scene.reset_copies(self.state, _FIRST_COPY, (self.np_random,))
         self._has_reset = True
         if self.render_mode == "human":
             self.render()
@@ -528,7 +528,7 @@ class MoreauJeanEnv(gym.Env[Any, Any]):
 
 
 class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
-    """``num_envs`` copies of a ``MoreauJeanTask`` stepped in one compiled call.
+    """``num_envs`` copies of a ``MoreauJeanScene`` stepped in one compiled call.
 
     Autoreset: ``AutoresetMode.NEXT_STEP`` (Gymnasium's default): the step after an episode
     ends resets that copy (its action is ignored, reward 0, terminated = truncated = False).
@@ -536,7 +536,7 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
     ``SyncVectorEnv`` seeds its sub-environments, so both give the same episodes.
     """
 
-    TASK: ClassVar[type[MoreauJeanTask]]
+    SCENE: ClassVar[type[MoreauJeanScene]]
     metadata: dict[str, Any] = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
@@ -545,15 +545,15 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
                  f"num_envs must be a positive integer, got {num_envs!r}")
         _require(render_mode is None, "the vector environments do not render; use gym.make "
                  "for a rendered single environment")  # fmt: skip
-        self.task = self.TASK(**options)
+        self.scene = self.SCENE(**options)
         self.num_envs = int(num_envs)
         self.max_episode_steps = max_episode_steps
         self.render_mode = None
-        self.single_observation_space = self.task.single_observation_space
-        self.single_action_space = self.task.single_action_space
+        self.single_observation_space = self.scene.single_observation_space
+        self.single_action_space = self.scene.single_action_space
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.state = BatchState(self.task, self.num_envs)
+        self.state = BatchState(self.scene, self.num_envs)
         self._rngs: list[np.random.Generator] = []
         self._autoreset = np.zeros(self.num_envs, np.bool_)
         self._step_mask = np.ones(self.num_envs, np.bool_)
@@ -561,7 +561,7 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
     @property
     def dt(self) -> float:
         """Duration of one env step [s]."""
-        return self.task.dt
+        return self.scene.dt
 
     def reset(self, *, seed: int | list[int | None] | None = None,
               options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:  # fmt: skip
@@ -594,7 +594,7 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         if seed is not None:
             self._np_random, self._np_random_seed = seeding.np_random(seeds[0])
         indices = np.flatnonzero(mask)
-        self.task.reset_copies(self.state, indices, [self._rngs[i] for i in indices])
+        self.scene.reset_copies(self.state, indices, [self._rngs[i] for i in indices])
         self._autoreset[mask] = False
         return self.state.obs.copy(), {}
 
@@ -602,9 +602,9 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         """Advance every copy by ``dt`` (copies that ended last step are reset instead)."""
         if not self._rngs:
             raise gym.error.ResetNeeded("call reset() before step()")
-        self.task.advance(self.state, actions)
+        self.scene.advance(self.state, actions)
         reward = self.state.reward
-        info = self.task.info_arrays(self.state)
+        info = self.scene.info_arrays(self.state)
         terminated = self.state.terminated != 0.0
         if self.max_episode_steps is not None:
             truncated = self.state.elapsed_steps >= self.max_episode_steps
@@ -613,7 +613,7 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         reward = reward.copy()
         resetting = np.flatnonzero(self._autoreset)
         if resetting.size:
-            self.task.reset_copies(self.state, resetting, [self._rngs[i] for i in resetting])
+            self.scene.reset_copies(self.state, resetting, [self._rngs[i] for i in resetting])
             reward[resetting] = 0.0
             terminated[resetting] = False
             truncated[resetting] = False
@@ -631,7 +631,7 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
 _COMPILED: dict[tuple[Any, ...], tuple[Any, Any, Any, Any]] = {}
 _FIRST_COPY = np.zeros(1, np.int64)
 SETTINGS_SIZE = 11
-"""Entries of ``MoreauJeanTask._task_array`` before the model's parameter record."""
+"""Entries of ``MoreauJeanScene._settings_array`` before the model's parameter record."""
 ADVANCE_OK, ADVANCE_ACTION_NOT_FINITE, ADVANCE_STATE_NOT_FINITE, ADVANCE_ACTION_SHAPE = 0, 1, 2, 3
 """Outcomes of the compiled ``advance``."""
 
@@ -696,8 +696,8 @@ def _info_builder(keys: tuple[str, ...]) -> Any:
 _INFO_BUILDERS: dict[tuple[str, ...], Any] = {}
 
 
-def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
-    """The batched kernels of ``task``: compiled once per task class, stepper kernel, parameter
+def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
+    """The batched kernels of ``scene``: compiled once per scene class, stepper kernel, parameter
     record type and state layout, per process.
 
     Returns (advance, observe_all, distance_one, restart). ``advance(levels, buffer)`` checks
@@ -709,9 +709,9 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     over the copies after the physics (``evaluate``) takes row views of every copy and is
     compiled without reference counting (``mdi_envs._borrowing``).
     """
-    step_batch, record = task.stepper.compiled_step_batch[:2]
-    layout = StateLayout.of(task)
-    key = (type(task), step_batch, type(record), layout)
+    step_batch, record = scene.stepper.compiled_step_batch[:2]
+    layout = StateLayout.of(scene)
+    key = (type(scene), step_batch, type(record), layout)
     if key in _COMPILED:
         return _COMPILED[key]
     record_entries = ", ".join(f"settings[{SETTINGS_SIZE + i}]" for i in range(len(record)))
@@ -720,13 +720,13 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     read_record = njit(inline="always")(namespace["read_record"])
     carve_state = _state_carver(layout)[2]
     constants_start = SETTINGS_SIZE + len(record)
-    num_torques = task.MODEL.NUM_INPUTS
-    width = num_torques + task.MODEL.NUM_BRAKES  # of one copy's levels
+    num_torques = scene.MODEL.NUM_INPUTS
+    width = num_torques + scene.MODEL.NUM_BRAKES  # of one copy's levels
     # inlined into ``evaluate``: no call per copy, and one copy's array views stay local
-    observe_one = njit(inline="always")(task.observe_one)
-    distance_one = njit(inline="always")(task.distance_one)
-    success_one = njit(inline="always")(task.success_one)
-    info_one = njit(inline="always")(task.info_one)
+    observe_one = njit(inline="always")(scene.observe_one)
+    distance_one = njit(inline="always")(scene.distance_one)
+    success_one = njit(inline="always")(scene.success_one)
+    info_one = njit(inline="always")(scene.info_one)
 
     @borrowing_njit
     def evaluate(q, u, tau, brake, impulses, physics, c, dt, horizon, effort_weight,  # noqa: ANN001
@@ -800,7 +800,7 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     @njit
     def restart(indices, buffer):  # noqa: ANN001
         """Zero the episode state of the copies ``indices`` (q, u already set), then their
-        Phi and observation (see ``MoreauJeanTask.reset_copies``).
+        Phi and observation (see ``MoreauJeanScene.reset_copies``).
         """
         (_, _, q, u, tau, brake, impulses, _, _, elapsed, effort, potential, terminated, _, obs,
          settings) = carve_state(buffer)
@@ -816,7 +816,7 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
             potential[i] = -shaping_weight * distance_one(q[i], u[i], c)
             observe_one(q[i], u[i], brake[i], horizon * dt, c, obs[i])
 
-    frozen = freeze(f"task_{type(task).__name__}",
+    frozen = freeze(f"scene_{type(scene).__name__}",
                     {"advance": advance, "observe_all": observe_all,
                      "distance_one": distance_one, "restart": restart})
     _COMPILED[key] = (frozen["advance"], frozen["observe_all"], frozen["distance_one"],
@@ -824,4 +824,4 @@ def _compiled(task: MoreauJeanTask) -> tuple[Any, Any, Any, Any]:
     return _COMPILED[key]
 
 
-__all__ = ["BatchState", "MoreauJeanEnv", "MoreauJeanTask", "MoreauJeanVectorEnv"]
+__all__ = ["BatchState", "MoreauJeanEnv", "MoreauJeanScene", "MoreauJeanVectorEnv"]

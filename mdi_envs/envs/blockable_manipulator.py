@@ -13,7 +13,7 @@ from gymnasium import spaces
 from mdi_envs._types import FloatArray
 from mdi_envs.angles import cos_sin, wrap_angle
 from mdi_envs.envs._actions import TorqueBrakeActions
-from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
+from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanScene, MoreauJeanVectorEnv
 from mdi_envs.maneuvers import MANIPULATOR_MANEUVER
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulator
 from mdi_envs.mechanics.parameters import require_positive
@@ -21,7 +21,7 @@ from mdi_envs.mechanics.parameters import require_positive
 VELOCITY_WEIGHT = 0.3  # [s] weight of the speeds in the goal distance (rad/s -> rad)
 
 
-class BlockableManipulatorTask(MoreauJeanTask):
+class BlockableManipulatorScene(MoreauJeanScene):
     """Batched logic of the manipulator environments (documented on the env class)."""
 
     MODEL = BlockableManipulator
@@ -102,7 +102,7 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
     Two uniform rods (1 m, 1 kg each) move in a horizontal plane (no gravity). A motor drives
     the absolute angle alpha of the first link; the second link (absolute angle beta) is
     passive, but a brake on the relative angle beta - alpha can block it *instantly*: an
-    impulsive, set-valued control. The task (Yunt & Glocker 2007, section 3.1) is to swing the
+    impulsive, set-valued control. The maneuver (Yunt & Glocker 2007, section 3.1) is to swing the
     arm from alpha = beta = 0 at rest to alpha = beta = pi at rest as fast as possible. The
     optimal maneuver uses the brake to store and release the second link's motion; the
     shipped optimal-control reference takes 4.256 s (``optimal.load_reference("manipulator_time")``;
@@ -186,22 +186,22 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
     Systems", HSCC 2007, section 3.1 and Figs. 3-4.
     """
 
-    TASK = BlockableManipulatorTask
-    task: BlockableManipulatorTask
+    SCENE = BlockableManipulatorScene
+    scene: BlockableManipulatorScene
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
 
     def _draw(self) -> Any:
         from mdi_envs.rendering import draw_manipulator
 
         return draw_manipulator(self.state.q[0], bool(self.state.brake[0, 0] > 0.0),
-                                float(self.state.tau[0, 0]) / self.task.max_torque,
-                                self.task.parameters)  # fmt: skip
+                                float(self.state.tau[0, 0]) / self.scene.max_torque,
+                                self.scene.parameters)  # fmt: skip
 
 
 class BlockableManipulatorVectorEnv(MoreauJeanVectorEnv):
     """``num_envs`` copies of ``BlockableManipulatorEnv`` in one compiled step (same arguments)."""
 
-    TASK = BlockableManipulatorTask
+    SCENE = BlockableManipulatorScene
 
 
-__all__ = ["BlockableManipulatorEnv", "BlockableManipulatorTask", "BlockableManipulatorVectorEnv"]
+__all__ = ["BlockableManipulatorEnv", "BlockableManipulatorScene", "BlockableManipulatorVectorEnv"]

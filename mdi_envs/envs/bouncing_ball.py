@@ -14,7 +14,7 @@ from mdi_envs._types import FloatArray
 from mdi_envs.envs._actions import TorqueBrakeActions
 from mdi_envs.envs.base import (
     MoreauJeanEnv,
-    MoreauJeanTask,
+    MoreauJeanScene,
     MoreauJeanVectorEnv,
     build_parameters,
 )
@@ -29,7 +29,7 @@ GAP_TOLERANCE = 1e-3  # [m] |y - r| at success
 VELOCITY_WEIGHT = 0.3  # [s] weight of the horizontal speed in the goal distance
 
 
-class BouncingBallTask(MoreauJeanTask):
+class BouncingBallScene(MoreauJeanScene):
     """Batched logic of the bouncing-ball environments (documented on the env class)."""
 
     MODEL = BouncingBall
@@ -124,7 +124,7 @@ class BouncingBallEnv(MoreauJeanEnv):
     rest with its centre at 1 m above rigid ground; Newton's impact law with restitution
     `eps` (default 0.8) makes it bounce with apex heights falling as eps^(2k), and the impacts
     accumulate in finite time (Zeno), after which the ball rests on the ground. The simple
-    control task: a bounded horizontal force must bring the ball to x = 1 m at rest, on the
+    control problem: a bounded horizontal force must bring the ball to x = 1 m at rest, on the
     ground. With the default frictionless ground the force does not interact with the
     impacts, so the episode cannot end before the bouncing has died out (t_inf = 3.96 s with
     the defaults); with `friction_coefficient > 0` the impacts also brake the horizontal
@@ -211,20 +211,20 @@ class BouncingBallEnv(MoreauJeanEnv):
     freedom dynamics", CISM 302, 1988; C. Glocker, "Set-Valued Force Laws", 2001.
     """
 
-    TASK = BouncingBallTask
-    task: BouncingBallTask
+    SCENE = BouncingBallScene
+    scene: BouncingBallScene
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 100}
 
     def _draw(self) -> Any:
         from mdi_envs.rendering import draw_bouncing_ball
 
-        return draw_bouncing_ball(self.state.q[0], self.task.parameters)
+        return draw_bouncing_ball(self.state.q[0], self.scene.parameters)
 
 
 class BouncingBallVectorEnv(MoreauJeanVectorEnv):
     """``num_envs`` copies of ``BouncingBallEnv`` in one compiled step (same arguments)."""
 
-    TASK = BouncingBallTask
+    SCENE = BouncingBallScene
 
 
-__all__ = ["BouncingBallEnv", "BouncingBallTask", "BouncingBallVectorEnv"]
+__all__ = ["BouncingBallEnv", "BouncingBallScene", "BouncingBallVectorEnv"]

@@ -14,7 +14,7 @@ from gymnasium import spaces
 from mdi_envs._types import FloatArray
 from mdi_envs.angles import cos_sin, wrap_angle
 from mdi_envs.envs._actions import TorqueBrakeActions
-from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanTask, MoreauJeanVectorEnv
+from mdi_envs.envs.base import MoreauJeanEnv, MoreauJeanScene, MoreauJeanVectorEnv
 from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
 from mdi_envs.mechanics.models.diff_drive import DiffDriveRobot
 from mdi_envs.mechanics.parameters import require_positive
@@ -26,7 +26,7 @@ YAW_RATE_WEIGHT = 0.25  # [m s/rad] weight of the yaw rate in the goal distance
 SLIDING_SPEED = 1e-4  # [m/s] a contact is drawn as sliding above this slip speed
 
 
-class DiffDriveRobotTask(MoreauJeanTask):
+class DiffDriveRobotScene(MoreauJeanScene):
     """Batched logic of the diff-drive environments (documented on the env class)."""
 
     MODEL = DiffDriveRobot
@@ -99,7 +99,7 @@ class DiffDriveRobotTask(MoreauJeanTask):
 
     @staticmethod
     def success_one(q: Any, u: Any, c: Any) -> bool:
-        """Position, heading, speed and yaw rate within the task's tolerances."""
+        """Position, heading, speed and yaw rate within the maneuver's tolerances."""
         dx, dy = q[0] - c[0], q[1] - c[1]
         e_phi = wrap_angle(q[2] - c[2])
         return (math.sqrt(dx * dx + dy * dy) <= c[3] and abs(e_phi) <= c[4]
@@ -124,7 +124,7 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     on the ground, all three with isotropic Coulomb friction whose normal loads shift with
     the friction forces (load transfer: the centre of mass is 0.15 m above the ground). Wheel
     torques beyond the traction limit make a wheel slip: the robot switches between the
-    paper's 2-DOF (both wheels roll), 3-DOF (one slips) and 5-DOF (both slip) modes. The task
+    paper's 2-DOF (both wheels roll), 3-DOF (one slips) and 5-DOF (both slip) modes. The maneuver
     (Yunt & Glocker 2007, section 3.2): from rest at the origin, heading +x, to
     (x, y, phi) = (2 m, 5 m, -pi/2) at rest, wheel angles free.
     `task="time"` is maneuver B (time-optimal; paper 4.03 s); `task="effort"` is maneuver A
@@ -200,8 +200,8 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     Systems", HSCC 2007, section 3.2, Table 1 and Figs. 7-9.
     """
 
-    TASK = DiffDriveRobotTask
-    task: DiffDriveRobotTask
+    SCENE = DiffDriveRobotScene
+    scene: DiffDriveRobotScene
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 20}
 
     def __init__(self, render_mode: str | None = None, **options: Any) -> None:
@@ -215,20 +215,20 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
         if not self._trail or self.state.elapsed_steps[0] == 0:
             self._trail = []
         self._trail.append((float(q[0]), float(q[1])))
-        rows = np.array(DiffDriveRobot.contact_directions(q, self.task.parameters.values(),
+        rows = np.array(DiffDriveRobot.contact_directions(q, self.scene.parameters.values(),
                                                           math))  # fmt: skip
         slip = (rows @ self.state.u[0]).reshape(3, 3)[:, 1:]
         sliding = np.hypot(slip[:, 0], slip[:, 1]) > SLIDING_SPEED
         impulses = self.state.impulses[0].reshape(3, 3)
-        return draw_diff_drive(q, self.task.parameters, DIFF_DRIVE_MANEUVER.goal_pose,
-                               contact_forces=impulses[:, 1:] / self.task.stepper.time_step,
+        return draw_diff_drive(q, self.scene.parameters, DIFF_DRIVE_MANEUVER.goal_pose,
+                               contact_forces=impulses[:, 1:] / self.scene.stepper.time_step,
                                sliding=sliding, trail=self._trail)  # fmt: skip
 
 
 class DiffDriveRobotVectorEnv(MoreauJeanVectorEnv):
     """``num_envs`` copies of ``DiffDriveRobotEnv`` in one compiled step (same arguments)."""
 
-    TASK = DiffDriveRobotTask
+    SCENE = DiffDriveRobotScene
 
 
-__all__ = ["DiffDriveRobotEnv", "DiffDriveRobotTask", "DiffDriveRobotVectorEnv"]
+__all__ = ["DiffDriveRobotEnv", "DiffDriveRobotScene", "DiffDriveRobotVectorEnv"]

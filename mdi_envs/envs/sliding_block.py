@@ -14,7 +14,7 @@ from mdi_envs._types import FloatArray
 from mdi_envs.envs._actions import TorqueBrakeActions
 from mdi_envs.envs.base import (
     MoreauJeanEnv,
-    MoreauJeanTask,
+    MoreauJeanScene,
     MoreauJeanVectorEnv,
     build_parameters,
 )
@@ -29,7 +29,7 @@ STICK_SPEED = 1e-6  # [m/s] the block counts as sticking below this slip speed, 
 CONTACT_GAP = 1e-6  # [m] the block counts as in contact below this normal distance
 
 
-class SlidingBlockTask(MoreauJeanTask):
+class SlidingBlockScene(MoreauJeanScene):
     """Batched logic of the sliding-block environments (documented on the env class)."""
 
     MODEL = SlidingBlock
@@ -105,7 +105,7 @@ class SlidingBlockEnv(MoreauJeanEnv):
     ## Description
     A validation scene for Coulomb stick-slip. A block (point mass 1 kg) rests on a slope of
     angle theta (default 0.5 rad) with friction coefficient mu (default 0.5); since
-    tan(theta) = 0.546 > mu it slides down unless pushed. The simple control task: a bounded
+    tan(theta) = 0.546 > mu it slides down unless pushed. The simple control problem: a bounded
     force along the slope must bring the block from s = 0 to s = -0.5 m (0.5 m up-slope) and
     stop it there. Holding it needs a force in the friction cone
     [-m g (sin theta + mu cos theta), -m g (sin theta - mu cos theta)] = [-9.01, -0.40] N;
@@ -193,21 +193,21 @@ class SlidingBlockEnv(MoreauJeanEnv):
     Dynamics with Unilateral Contacts", 1996.
     """
 
-    TASK = SlidingBlockTask
-    task: SlidingBlockTask
+    SCENE = SlidingBlockScene
+    scene: SlidingBlockScene
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 100}
 
     def _draw(self) -> Any:
         from mdi_envs.rendering import draw_sliding_block
 
-        return draw_sliding_block(self.state.q[0], self.task.parameters,
+        return draw_sliding_block(self.state.q[0], self.scene.parameters,
                                   target_position=GOAL_S)  # fmt: skip
 
 
 class SlidingBlockVectorEnv(MoreauJeanVectorEnv):
     """``num_envs`` copies of ``SlidingBlockEnv`` in one compiled step (same arguments)."""
 
-    TASK = SlidingBlockTask
+    SCENE = SlidingBlockScene
 
 
-__all__ = ["SlidingBlockEnv", "SlidingBlockTask", "SlidingBlockVectorEnv"]
+__all__ = ["SlidingBlockEnv", "SlidingBlockScene", "SlidingBlockVectorEnv"]

@@ -209,9 +209,9 @@ def test_start_state_is_the_nominal_one_plus_uniform_noise(env_id: str) -> None:
     scale = 0.05
     env = make(env_id, reset_noise_scale=scale)
     env.reset(seed=7)
-    task = env.unwrapped.task
-    entries = list(task.START_NOISE_ENTRIES)
-    expected = task.nominal_start()
+    scene = env.unwrapped.scene
+    entries = list(scene.START_NOISE_ENTRIES)
+    expected = scene.nominal_start()
     expected[entries] += gym.utils.seeding.np_random(7)[0].uniform(-scale, scale, len(entries))
     state = env.unwrapped.state
     np.testing.assert_array_equal(np.concatenate([state.q[0], state.u[0]]), expected)

@@ -60,7 +60,7 @@ def test_brake_force_mode_is_a_tresca_element() -> None:
     box = make()
     for env in (released, weak, box):
         env.reset(seed=4)
-    dt = released.unwrapped.task.stepper.time_step
+    dt = released.unwrapped.scene.stepper.time_step
     level = float(np.float32(-0.998))  # the value the float32 action carries
     bound = 0.5 * 50.0 * (level + 1.0)  # 0.05 N m: too weak to hold, the brake slips
     for _ in range(30):

@@ -2,7 +2,7 @@
 
 Through the environments (zero action): the ball's first impact time, first apex and Zeno
 accumulation time; the block's sliding acceleration, exact sticking under a holding force and
-its up-slope acceleration. A hand-written PD controller solves each task; invalid physics and
+its up-slope acceleration. A hand-written PD controller solves each scene; invalid physics and
 NaN actions raise ValueError. (The generic API contracts are in test_api.py.)
 """
 
@@ -36,7 +36,7 @@ ZERO = np.zeros(1, np.float32)
 # -- bouncing ball -----------------------------------------------------------------------------
 def test_ball_free_fall_impacts_and_zeno_rest_match_closed_forms() -> None:
     env = make(BALL_ID, reset_noise_scale=0.0)
-    p = env.unwrapped.task.parameters
+    p = env.unwrapped.scene.parameters
     dt = env.unwrapped.dt
     eps, g, r = p.restitution, p.gravity, p.radius
     drop = 1.0 - r  # the centre starts 1 m up: the fall to contact
@@ -64,7 +64,7 @@ def test_ball_free_fall_impacts_and_zeno_rest_match_closed_forms() -> None:
     # first apex after the bounce: eps^2 (h0 - r) above contact, within O(dt)
     second_up = first_up + int(np.argmax(speeds_a[first_up:] < 0.0))
     apex = gaps_a[first_up : second_up + 1].max()
-    time_step = env.unwrapped.task.stepper.time_step
+    time_step = env.unwrapped.scene.stepper.time_step
     impact_speed = math.sqrt(2.0 * g * drop)
     assert apex == pytest.approx(eps**2 * drop, abs=2.0 * impact_speed * time_step)
     # still bouncing well before t_inf, at rest on the ground shortly after it
@@ -81,7 +81,7 @@ def test_ball_free_fall_impacts_and_zeno_rest_match_closed_forms() -> None:
 
 def test_ball_pd_controller_reaches_the_goal() -> None:
     env = make(BALL_ID)
-    task = env.unwrapped.task
+    scene = env.unwrapped.scene
     kp, kd = 0.4, 0.4  # [N/m], [N s/m]: critically damped for the 0.1 kg ball (2 rad/s)
     obs, _ = env.reset(seed=3)
     terminated = truncated = False
@@ -89,7 +89,7 @@ def test_ball_pd_controller_reaches_the_goal() -> None:
     while not (terminated or truncated):
         force = -kp * obs[0] - kd * obs[2]
         obs, _, terminated, truncated, info = env.step(
-            np.array([force / task.max_force], np.float32)
+            np.array([force / scene.max_force], np.float32)
         )
     assert terminated and not truncated and info["is_success"]
     assert abs(obs[0]) <= 0.02 and abs(obs[2]) <= 0.05
@@ -111,7 +111,7 @@ def test_ball_friction_brakes_the_horizontal_motion_at_impacts() -> None:
 
 # -- sliding block -----------------------------------------------------------------------------
 def block_constants(env: gym.Env[Any, Any]) -> tuple[float, float, float, float]:
-    p = env.unwrapped.task.parameters
+    p = env.unwrapped.scene.parameters
     return p.mass, p.gravity, p.slope_angle, p.friction_coefficient
 
 
@@ -130,7 +130,7 @@ def test_block_slides_down_at_the_coulomb_acceleration() -> None:
         -mu * info["normal_impulse"]
     )  # sliding: P_T on the cone's edge, opposing s' > 0
     assert info["normal_impulse"] == pytest.approx(
-        m * g * math.cos(theta) * env.unwrapped.task.stepper.time_step
+        m * g * math.cos(theta) * env.unwrapped.scene.stepper.time_step
     )
 
 
@@ -141,7 +141,7 @@ def test_block_sticks_exactly_under_a_holding_force_in_the_cone(fraction: float)
     low = -m * g * (math.sin(theta) + mu * math.cos(theta))
     high = -m * g * (math.sin(theta) - mu * math.cos(theta))
     force = high + fraction * (low - high)
-    action = np.array([force / env.unwrapped.task.max_force], np.float32)
+    action = np.array([force / env.unwrapped.scene.max_force], np.float32)
     env.reset(seed=0)
     for _ in range(50):
         obs, _, _, _, info = env.step(action)
@@ -152,7 +152,7 @@ def test_block_sticks_exactly_under_a_holding_force_in_the_cone(fraction: float)
 def test_block_pushed_up_accelerates_at_the_closed_form() -> None:
     env = make(BLOCK_ID, reset_noise_scale=0.0)
     m, g, theta, mu = block_constants(env)
-    force = -0.75 * env.unwrapped.task.max_force  # beyond the cone: -15 N vs -9.01 N
+    force = -0.75 * env.unwrapped.scene.max_force  # beyond the cone: -15 N vs -9.01 N
     acceleration = force / m + g * (math.sin(theta) + mu * math.cos(theta))
     assert acceleration < 0.0
     env.reset(seed=0)
@@ -164,7 +164,7 @@ def test_block_pushed_up_accelerates_at_the_closed_form() -> None:
 def test_block_pd_controller_reaches_the_goal() -> None:
     env = make(BLOCK_ID)
     m, g, theta, _ = block_constants(env)
-    task = env.unwrapped.task
+    scene = env.unwrapped.scene
     kp, kd = 400.0, 40.0  # [N/m], [N s/m]: critically damped at 20 rad/s for 1 kg
     obs, _ = env.reset(seed=3)
     terminated = truncated = False
@@ -173,7 +173,7 @@ def test_block_pd_controller_reaches_the_goal() -> None:
     while not (terminated or truncated):
         force = -m * g * math.sin(theta) - kp * obs[0] - kd * obs[1]  # gravity compensated
         obs, _, terminated, truncated, info = env.step(
-            np.array([force / task.max_force], np.float32)
+            np.array([force / scene.max_force], np.float32)
         )
         steps += 1
     assert terminated and not truncated and info["is_success"]
@@ -226,8 +226,8 @@ def test_wrong_parameters_type_and_nan_action_raise(env_id: str) -> None:
 
 def test_convenience_arguments_override_the_parameters() -> None:
     env = make(BALL_ID, parameters=BouncingBallParameters(mass=0.2), restitution=0.5)
-    p = env.unwrapped.task.parameters
+    p = env.unwrapped.scene.parameters
     assert (p.mass, p.restitution, p.friction_coefficient) == (0.2, 0.5, 0.0)
     env = make(BLOCK_ID, friction_coefficient=0.7, slope_angle=0.3)
-    p = env.unwrapped.task.parameters
+    p = env.unwrapped.scene.parameters
     assert (p.friction_coefficient, p.slope_angle, p.mass) == (0.7, 0.3, 1.0)

@@ -141,7 +141,7 @@ def test_bouncing_ball_env_takes_the_option_and_pickles() -> None:
             _, _, _, _, info = env.step(np.zeros(1, np.float32))
             worst = max(worst, info["penetration"])
         penetration[locate] = worst
-        stepper = env.unwrapped.task.stepper
+        stepper = env.unwrapped.scene.stepper
         assert pickle.loads(pickle.dumps(stepper)).locate_impacts == locate
         env.close()
     assert penetration[True] <= 1e-12
