@@ -3,7 +3,7 @@
 Wiring (in ``mdi_envs/cli.py``): ``from baselines.cli import add_train_parser`` and call
 ``add_train_parser(commands)`` on the subparsers (likewise ``add_compare_parser``,
 ``add_sweep_parser``); each parser's handler is its ``run_*`` function.
-Example: ``mdi-envs train mdi_envs/DiffDriveRobot-v0 PPO --task effort --output
+Example: ``mdi-envs train mdi_envs/DiffDriveRobot-v0 PPO --objective effort --output
 results/baselines`` (5 x 10^6 steps; the budget and settings are in
 ``baselines/hyperparams/*.yml``, rl-zoo3's format) shows SB3's progress bar on a terminal and
 writes the model zip, its JSON config, the episode CSV, the training-curve PNG and TensorBoard
@@ -22,7 +22,7 @@ from typing import Any
 
 def add_train_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Add the ``train`` subcommand to an argparse subparsers object; returns its parser."""
-    from baselines.hyperparameters import ALGORITHMS, DEFAULT_TASKS, canonical_algorithm
+    from baselines.hyperparameters import ALGORITHMS, DEFAULT_OBJECTIVES, canonical_algorithm
 
     parser = subparsers.add_parser(
         "train",
@@ -33,11 +33,11 @@ def add_train_parser(subparsers: Any) -> argparse.ArgumentParser:
         "STEM_episodes.csv, STEM.png and TensorBoard logs into --output. Needs the rl extra "
         "(pip install 'mdi-envs[rl]').",
     )
-    parser.add_argument("env_id", choices=sorted(DEFAULT_TASKS), help="the environment")
+    parser.add_argument("env_id", choices=sorted(DEFAULT_OBJECTIVES), help="the environment")
     parser.add_argument("algo", type=canonical_algorithm, choices=ALGORITHMS,
                         help="the algorithm (case-insensitive; HybridPPO: the manipulator's "
                         "hybrid brake x torque action space)")
-    parser.add_argument("--task", choices=("time", "effort"), default=None,
+    parser.add_argument("--objective", choices=("time", "effort"), default=None,
                         help="objective (effort: diff drive only; default time)")
     parser.add_argument("--seed", type=int, default=None, help="seed (default: the table's)")
     parser.add_argument("--timesteps", type=int, default=None,
@@ -59,13 +59,13 @@ def run_train(args: argparse.Namespace) -> int:
     from baselines.train import train
 
     progress = False if args.no_progress_bar else None
-    model_path = train(args.env_id, args.algo, task=args.task, seed=args.seed,
+    model_path = train(args.env_id, args.algo, objective=args.objective, seed=args.seed,
                        total_timesteps=args.timesteps, output=args.output,
                        num_envs=args.num_envs, eval_episodes=args.eval_episodes,
                        progress_bar=progress)  # fmt: skip
     config = json.loads(model_path.with_suffix(".json").read_text())
     evaluation = config["evaluation"]
-    print(f"trained {config['algo']} on {config['env_id']} ({config['task']}): "
+    print(f"trained {config['algo']} on {config['env_id']} ({config['objective']}): "
           f"{config['num_timesteps']} steps in {config['wall_time_s']:.1f} s, "
           f"{config['num_episodes']} episodes")  # fmt: skip
     if evaluation.get("mean_return") is not None:
@@ -81,7 +81,7 @@ def run_train(args: argparse.Namespace) -> int:
 
 def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Add the ``compare`` subcommand to an argparse subparsers object; returns its parser."""
-    from baselines.compare import TASKS
+    from baselines.compare import OBJECTIVES
 
     parser = subparsers.add_parser(
         "compare",
@@ -95,11 +95,11 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
         "compare_ENV_TASK.json and .png (trajectories, brake schedules / slip modes, scores), "
         "seeds_ENV_TASK.png (performance profiles, training curves with CI bands from the "
         "STEM_episodes.csv files) and compare.md into --output. ENV_ID 'all' runs both mission "
-        "envs, every task.",
+        "envs, every objective.",
     )
-    parser.add_argument("env_id", choices=[*sorted(TASKS), "all"], help="the environment")
-    parser.add_argument("--task", choices=("time", "effort"), default=None,
-                        help="one task (default: every task of the env)")
+    parser.add_argument("env_id", choices=[*sorted(OBJECTIVES), "all"], help="the environment")
+    parser.add_argument("--objective", choices=("time", "effort"), default=None,
+                        help="one objective (default: every objective of the env)")
     parser.add_argument("--seeds", type=int, default=20,
                         help="perturbed starts per run (per training seed and controller)")
     parser.add_argument("--trained", type=Path, default=None,
@@ -121,12 +121,12 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def run_compare(args: argparse.Namespace) -> int:
-    """Handler of ``compare``: runs each env x task, prints and writes the table; returns 0."""
+    """Handler of ``compare``: runs each env x objective, prints and writes the table; returns 0."""
     import json
     import sys
 
     from baselines.compare import (
-        TASKS,
+        OBJECTIVES,
         TRAINED_DIR,
         collect_tables,
         compare,
@@ -137,32 +137,32 @@ def run_compare(args: argparse.Namespace) -> int:
 
     if args.seeds < 1:
         raise SystemExit(f"compare: --seeds must be >= 1, got {args.seeds}")
-    env_ids = sorted(TASKS) if args.env_id == "all" else [args.env_id]
-    jobs = [(env_id, task) for env_id in env_ids for task in TASKS[env_id]
-            if args.task in (None, task)]  # fmt: skip
+    env_ids = sorted(OBJECTIVES) if args.env_id == "all" else [args.env_id]
+    jobs = [(env_id, objective) for env_id in env_ids for objective in OBJECTIVES[env_id]
+            if args.objective in (None, objective)]  # fmt: skip
     if not jobs:
-        raise SystemExit(f"compare: {args.env_id} has no task {args.task!r}")
+        raise SystemExit(f"compare: {args.env_id} has no objective {args.objective!r}")
     trained_dir = TRAINED_DIR if args.trained is None else args.trained
-    for env_id, task in jobs:
+    for env_id, objective in jobs:
         extra = []
         if args.mpc:
             from baselines.model_based import mpc_controller
 
-            controller = mpc_controller(env_id, task)
+            controller = mpc_controller(env_id, objective)
             if controller is None:
                 raise SystemExit("compare: --mpc needs CasADi (pip install 'mdi-envs[optimal]')")
             extra.append(controller)
         try:
-            comparison = compare(env_id, task, num_seeds=args.seeds, trained_dir=trained_dir,
+            comparison = compare(env_id, objective, num_seeds=args.seeds, trained_dir=trained_dir,
                                  bootstrap_reps=args.bootstrap_reps, extra_controllers=extra,
                                  log=lambda line: print(line, file=sys.stderr, flush=True),
                                  only=args.controllers)
         except ValueError as error:
             raise SystemExit(f"compare: {error}") from error
-        previous = args.output / f"compare_{env_id.split('/')[-1]}_{task}.json"
+        previous = args.output / f"compare_{env_id.split('/')[-1]}_{objective}.json"
         if args.controllers is not None and previous.exists():
             comparison = merge_comparisons(json.loads(previous.read_text()), comparison,
-                                           shipped_algorithms(env_id, task, trained_dir))
+                                           shipped_algorithms(env_id, objective, trained_dir))
         for path in write_comparison(comparison, args.output, trained_dir):
             print(f"wrote {path}", file=sys.stderr)
     table = collect_tables(args.output)
@@ -173,12 +173,12 @@ def run_compare(args: argparse.Namespace) -> int:
 
 def add_sweep_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Add the ``sweep`` subcommand to an argparse subparsers object; returns its parser."""
-    from baselines.hyperparameters import ALGORITHMS, DEFAULT_TASKS, canonical_algorithm
+    from baselines.hyperparameters import ALGORITHMS, DEFAULT_OBJECTIVES, canonical_algorithm
 
     parser = subparsers.add_parser(
         "sweep",
-        help="train the seed x algorithm x task grid through Ray Tune (resumable)",
-        description="Run mdi-envs train for every (env, task, algorithm) of the settings in "
+        help="train the seed x algorithm x objective grid through Ray Tune (resumable)",
+        description="Run mdi-envs train for every (env, objective, algorithm) of the settings in "
         "baselines/hyperparams and every --seeds, one Ray Tune trial each, locally on this "
         "machine's cores or on an existing Ray cluster (--address). A run whose STEM.json is "
         "already in --output is never rerun: the same command resumes an interrupted sweep. "
@@ -187,10 +187,10 @@ def add_sweep_parser(subparsers: Any) -> argparse.ArgumentParser:
     )
     parser.add_argument("--algos", nargs="+", type=canonical_algorithm, choices=ALGORITHMS,
                         default=["PPO", "HybridPPO"], help="algorithms (default: PPO HybridPPO)")
-    parser.add_argument("--env-ids", nargs="+", choices=sorted(DEFAULT_TASKS), default=None,
+    parser.add_argument("--env-ids", nargs="+", choices=sorted(DEFAULT_OBJECTIVES), default=None,
                         help="environments (default: both)")
-    parser.add_argument("--tasks", nargs="+", choices=("time", "effort"), default=None,
-                        help="tasks (default: every task the settings have)")
+    parser.add_argument("--objectives", nargs="+", choices=("time", "effort"), default=None,
+                        help="objectives (default: every objective the settings have)")
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3, 4],
                         help="training seeds (default: 0 1 2 3 4)")
     parser.add_argument("--output", type=Path, default=Path("results/sweep"),
@@ -218,9 +218,9 @@ def run_sweep(args: argparse.Namespace) -> int:
     """Handler of ``sweep``: runs the grid, prints each run's outcome; returns 1 on a failure."""
     from baselines.sweep import grid, is_finished, sweep
 
-    trials = grid(args.algos, args.seeds, args.env_ids, args.tasks)
+    trials = grid(args.algos, args.seeds, args.env_ids, args.objectives)
     if not trials:
-        raise SystemExit("sweep: no settings match these --algos, --env-ids and --tasks")
+        raise SystemExit("sweep: no settings match these --algos, --env-ids and --objectives")
     if args.dry_run:
         for trial in trials:
             state = "finished" if is_finished(trial, args.output) else "to run"

@@ -1,8 +1,8 @@
 """RL policies against the optimal reference in the same environment, over training seeds.
 
 ``compare("mdi_envs/DiffDriveRobot-v0", "effort")`` plays every trained policy of that env and
-task (``baselines/trained/STEM.zip`` with its ``STEM.json`` config; one per training seed,
-``{env}_{task}_{algo}_seed{S}``), deterministically, from ``reset(seed=s)`` for the starts
+objective (``baselines/trained/STEM.zip`` with its ``STEM.json`` config; one per training seed,
+``{env}_{objective}_{algo}_seed{S}``), deterministically, from ``reset(seed=s)`` for the starts
 ``0 ... num_seeds - 1``: each reset draws a small start perturbation (the env's
 ``reset_noise_scale``, 0.01 rad, rad/s or m, m/s by default). The controllers that are not
 trained (``CONTROLLER_FACTORIES``: the optimal reference, played open loop through the same env
@@ -13,14 +13,14 @@ Scores of one run (one training seed, or a controller): the success rate over th
 starts, and over its successful episodes the time to the goal [s] and the effort (integral of
 the squared torques [N^2 m^2 s]) as ratios to the optimum's (``reference.final_time`` and the
 reference's effort). Time to the goal is the episode's ``elapsed_time`` when it terminates at
-the goal ("time" tasks) or its fixed horizon ("effort"). Per algorithm, over its runs
+the goal ("time" objectives) or its fixed horizon ("effort"). Per algorithm, over its runs
 (``baselines.aggregate``, rliable): the interquartile mean and 95 % stratified-bootstrap
 confidence interval of each score; one run is reported as n=1 without interval.
 
-Outputs (``write_comparison``): ``compare_{env}_{task}.json`` (every run's episodes, summaries
-and aggregates, the reference's metadata), ``compare_{env}_{task}.png`` (the nominal
+Outputs (``write_comparison``): ``compare_{env}_{objective}.json`` (every run's episodes, summaries
+and aggregates, the reference's metadata), ``compare_{env}_{objective}.png`` (the nominal
 trajectories of every controller over the optimum's, with brake schedules or slip modes, and
-the scores), ``seeds_{env}_{task}.png`` (performance profiles over runs and training curves
+the scores), ``seeds_{env}_{objective}.png`` (performance profiles over runs and training curves
 with CI bands, ``baselines.seed_plots``) and the Markdown table ``markdown_table`` prints.
 """
 
@@ -50,11 +50,11 @@ REFERENCE_NAMES = {
     ("mdi_envs/DiffDriveRobot-v0", "time"): "diff_drive_time",
     ("mdi_envs/DiffDriveRobot-v0", "effort"): "diff_drive_effort",
 }
-"""(env id, task) -> the optimal reference it is measured against."""
+"""(env id, objective) -> the optimal reference it is measured against."""
 
-TASKS = {"mdi_envs/BlockableManipulator-v0": ("time",),
+OBJECTIVES = {"mdi_envs/BlockableManipulator-v0": ("time",),
          "mdi_envs/DiffDriveRobot-v0": ("time", "effort")}  # fmt: skip
-"""The tasks of each mission environment."""
+"""The objectives of each mission environment."""
 
 SCHEDULE_KEYS = {"mdi_envs/BlockableManipulator-v0": "brake_engaged",
                  "mdi_envs/DiffDriveRobot-v0": "slip_mode"}  # fmt: skip
@@ -90,7 +90,7 @@ class Controller:
 
 CONTROLLER_FACTORIES = ("baselines.compare:optimal_controller",)
 """The untrained controller rows, as "module:function" (imported on use); each function takes
-(env id, task) and returns a ``Controller``, or None where it does not apply. A model-based
+(env id, objective) and returns a ``Controller``, or None where it does not apply. A model-based
 controller (e.g. an MPC in ``optimal/``) joins every comparison by adding its entry here."""
 
 
@@ -192,34 +192,34 @@ def reference_controller(reference: Reference, label: str = OPTIMAL) -> Controll
     return Controller(label, lambda _env: open_loop_policy(actions), options)
 
 
-def optimal_controller(env_id: str, task: str) -> Controller | None:
-    """The optimal reference of (env id, task) played open loop; None without a reference."""
-    name = REFERENCE_NAMES.get((env_id, task))
+def optimal_controller(env_id: str, objective: str) -> Controller | None:
+    """The optimal reference of (env id, objective) played open loop; None without a reference."""
+    name = REFERENCE_NAMES.get((env_id, objective))
     return None if name is None else reference_controller(load_reference(name))
 
 
-def registered_controllers(env_id: str, task: str) -> list[Controller]:
-    """The ``CONTROLLER_FACTORIES`` controllers that apply to (env id, task), in order."""
+def registered_controllers(env_id: str, objective: str) -> list[Controller]:
+    """The ``CONTROLLER_FACTORIES`` controllers that apply to (env id, objective), in order."""
     controllers = []
     for target in CONTROLLER_FACTORIES:
         module, _, function = target.partition(":")
-        controller = getattr(importlib.import_module(module), function)(env_id, task)
+        controller = getattr(importlib.import_module(module), function)(env_id, objective)
         if controller is not None:
             controllers.append(controller)
     return controllers
 
 
 def reference_effort(reference: Reference) -> float:
-    """The reference's integral of sum(tau^2) [N^2 m^2 s] (its cost on "effort" tasks)."""
+    """The reference's integral of sum(tau^2) [N^2 m^2 s] (its cost on "effort" objectives)."""
     return float(np.sum(reference.tau**2) * reference.time_step)
 
 
-def shipped_policies(env_id: str, task: str, directory: Path = TRAINED_DIR) -> list[Path]:
-    """The JSON configs of the trained policies for (env id, task) in ``directory``, sorted."""
+def shipped_policies(env_id: str, objective: str, directory: Path = TRAINED_DIR) -> list[Path]:
+    """The JSON configs of the trained policies for (env id, objective) in ``directory``, sorted."""
     configs = []
     for path in sorted(Path(directory).glob("*.json")):
         config = json.loads(path.read_text())
-        if (config.get("env_id") == env_id and config.get("task") == task
+        if (config.get("env_id") == env_id and config.get("objective") == objective
                 and path.with_suffix(".zip").exists()):
             configs.append(path)
     return configs
@@ -234,9 +234,9 @@ def group_by_algorithm(configs: Sequence[Path]) -> dict[str, list[Path]]:
     return {algo: [path for _, path in sorted(runs)] for algo, runs in groups.items()}
 
 
-def shipped_algorithms(env_id: str, task: str, directory: Path = TRAINED_DIR) -> set[str]:
-    """The algorithms with at least one trained policy for (env id, task) in ``directory``."""
-    return set(group_by_algorithm(shipped_policies(env_id, task, directory)))
+def shipped_algorithms(env_id: str, objective: str, directory: Path = TRAINED_DIR) -> set[str]:
+    """The algorithms with at least one trained policy for (env id, objective) in ``directory``."""
+    return set(group_by_algorithm(shipped_policies(env_id, objective, directory)))
 
 
 def load_policy(config_path: Path) -> tuple[Controller, dict[str, Any]]:
@@ -325,7 +325,7 @@ def evaluate_controller(env_id: str, controller: Controller, seeds: Sequence[int
 
 def compare(
     env_id: str,
-    task: str,
+    objective: str,
     num_seeds: int = 20,
     policies: Sequence[Path] | None = None,
     extra_controllers: Sequence[Controller] = (),
@@ -337,9 +337,9 @@ def compare(
     """Evaluate the controllers and every run of every trained algorithm on the same starts.
 
     Args:
-        env_id: a mission environment id. task: "time" or "effort".
+        env_id: a mission environment id. objective: "time" or "effort".
         num_seeds: perturbed starts per run (seeds 0 ... num_seeds - 1).
-        policies: trained-policy JSON configs (default: ``shipped_policies(env_id, task,
+        policies: trained-policy JSON configs (default: ``shipped_policies(env_id, objective,
             trained_dir)``), one run each, grouped by algorithm.
         extra_controllers: more untrained controllers after the registered ones
             (``CONTROLLER_FACTORIES``; tests use a random policy and the reference's controls).
@@ -350,33 +350,34 @@ def compare(
             completed row by row (``merge_comparisons``); an unknown label is a ValueError.
 
     Returns:
-        {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort" [N^2 m^2 s],
+        {"env_id", "objective", "reference", "optimal_time" [s], "optimal_effort" [N^2 m^2 s],
         "seeds", "controllers": [{"label", "algo", "trained" (bool), "runs": [{"seed"
         (training seed, None for an untrained controller), "config", "summary", "nominal",
         "episodes"}], "aggregate": {score: ``iqm_interval``}}]}, the episodes as ``Episode``
         objects (``write_comparison`` turns them into JSON).
     """
-    if (env_id, task) not in REFERENCE_NAMES:
+    if (env_id, objective) not in REFERENCE_NAMES:
         known = ", ".join(f"{e} {t}" for e, t in REFERENCE_NAMES)
-        raise ValueError(f"no optimal reference for {env_id} task {task!r}; known: {known}")
+        raise ValueError(f"no optimal reference for {env_id} objective {objective!r}; "
+                         f"known: {known}")
     say = log or (lambda _: None)
-    reference = load_reference(REFERENCE_NAMES[(env_id, task)])
+    reference = load_reference(REFERENCE_NAMES[(env_id, objective)])
     optimal_time, optimal_effort = reference.final_time, reference_effort(reference)
     seeds = list(range(num_seeds))
-    configs = shipped_policies(env_id, task, trained_dir) if policies is None else policies
+    configs = shipped_policies(env_id, objective, trained_dir) if policies is None else policies
     groups: list[tuple[str, bool, list[tuple[Controller, dict[str, Any]]]]] = [
-        (c.label, False, [(c, {})]) for c in registered_controllers(env_id, task)]
+        (c.label, False, [(c, {})]) for c in registered_controllers(env_id, objective)]
     for algo, paths in group_by_algorithm(configs).items():
         groups.append((algo, True, [load_policy(path) for path in paths]))
     groups += [(c.label, False, [(c, {})]) for c in extra_controllers]
-    require_known_labels(only, [label for label, _, _ in groups], env_id, task)
+    require_known_labels(only, [label for label, _, _ in groups], env_id, objective)
     groups = [group for group in groups if only is None or group[0] in only]
     rows = []
     for label, trained, members in groups:
         runs = []
         for controller, config in members:
             seed = config.get("seed")
-            say(f"{env_id} {task}: {label}" + (f" seed {seed}" if trained else "")
+            say(f"{env_id} {objective}: {label}" + (f" seed {seed}" if trained else "")
                 + f", nominal start + {num_seeds} perturbed starts")  # fmt: skip
             nominal, episodes = evaluate_controller(env_id, controller, seeds)
             runs.append({"seed": seed, "config": config, "nominal": nominal,
@@ -385,18 +386,18 @@ def compare(
         rows.append({"label": label, "algo": label if trained else "controller",
                      "trained": trained, "runs": runs,
                      "aggregate": aggregate_runs(runs, bootstrap_reps)})  # fmt: skip
-    return {"env_id": env_id, "task": task, "reference": reference.name,
+    return {"env_id": env_id, "objective": objective, "reference": reference.name,
             "optimal_time": optimal_time, "optimal_effort": optimal_effort, "seeds": seeds,
             "controllers": rows}  # fmt: skip
 
 
 def require_known_labels(only: Sequence[str] | None, known: Sequence[str], env_id: str,
-                         task: str) -> None:
+                         objective: str) -> None:
     """Raise ValueError naming the labels of ``only`` that are not in ``known``."""
     unknown = sorted(set(only or ()) - set(known))
     if unknown:
-        raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} task "
-                         f"{task!r}; known: {', '.join(known)}")
+        raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} objective "
+                         f"{objective!r}; known: {', '.join(known)}")
 
 
 def budget_text(row: dict[str, Any]) -> str:
@@ -442,12 +443,12 @@ def _compute_text(row: dict[str, Any]) -> str:
 
 
 def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
-    """One row per env x task x controller: IQM [95 % CI] over runs (n) of each score.
+    """One row per env x objective x controller: IQM [95 % CI] over runs (n) of each score.
 
     A trained algorithm's runs are its training seeds; an untrained controller is one run
     (its cells show the value alone, "(controller)").
     """
-    lines = ["| env | task | controller | runs | success (perturbed starts), IQM [95 % CI] | "
+    lines = ["| env | objective | controller | runs | success (perturbed starts), IQM [95 % CI] | "
              "time / optimal | effort / optimal | nominal start | compute / step | "
              "training budget |",
              "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
@@ -466,7 +467,7 @@ def markdown_table(comparisons: Sequence[dict[str, Any]]) -> str:
                 cells = [f"{100 * aggregate['success_rate']['iqm']:.0f} %",
                          *(f"{v['iqm']:.2f}" if v["iqm"] is not None else "-"
                            for v in (aggregate["time_ratio"], aggregate["effort_ratio"]))]
-            lines.append(f"| {env} | {comparison['task']} | {row['label']} | {runs} | "
+            lines.append(f"| {env} | {comparison['objective']} | {row['label']} | {runs} | "
                          + " | ".join(cells)
                          + f" | {_nominal_text(row)} | {_compute_text(row)} | "
                          f"{budget_text(row)} |")  # fmt: skip
@@ -498,10 +499,10 @@ def merge_comparisons(old: dict[str, Any], new: dict[str, Any],
     Rows with the same label are replaced, the others kept in ``old``'s order and ``new``'s
     added after them; with ``shipped`` (the algorithms that have trained policies now,
     ``shipped_algorithms``) a trained row of another algorithm is dropped (its policies were
-    withdrawn). Both must compare the same env, task, reference (same optimum) and starts.
+    withdrawn). Both must compare the same env, objective, reference (same optimum) and starts.
     Kept rows come back as ``Episode`` objects (perturbed episodes without trajectories).
     """
-    for key in ("env_id", "task", "reference", "optimal_time", "optimal_effort", "seeds"):
+    for key in ("env_id", "objective", "reference", "optimal_time", "optimal_effort", "seeds"):
         if old.get(key) != new[key]:
             raise ValueError(f"cannot merge comparisons with different {key}: "
                              f"{old.get(key)!r} and {new[key]!r}")
@@ -522,7 +523,7 @@ def merge_comparisons(old: dict[str, Any], new: dict[str, Any],
 
 def write_comparison(comparison: dict[str, Any], output: Path,
                      trained_dir: Path = TRAINED_DIR) -> list[Path]:  # fmt: skip
-    """Write ``compare_{env}_{task}.{json,png,md}`` and ``seeds_{env}_{task}.png``.
+    """Write ``compare_{env}_{objective}.{json,png,md}`` and ``seeds_{env}_{objective}.png``.
 
     The ``.md`` is the comparison's ``markdown_table`` (``collect_tables`` joins them).
 
@@ -537,7 +538,7 @@ def write_comparison(comparison: dict[str, Any], output: Path,
 
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)
-    stem = f"{comparison['env_id'].split('/')[-1]}_{comparison['task']}"
+    stem = f"{comparison['env_id'].split('/')[-1]}_{comparison['objective']}"
     json_path = output / f"compare_{stem}.json"
     json_path.write_text(json.dumps(comparison_record(comparison), indent=1, default=str) + "\n")
     png_path = output / f"compare_{stem}.png"
@@ -550,9 +551,9 @@ def write_comparison(comparison: dict[str, Any], output: Path,
 
 
 def collect_tables(output: Path) -> str:
-    """One Markdown table of every ``compare_*.md`` in ``output`` (env x task, sorted).
+    """One Markdown table of every ``compare_*.md`` in ``output`` (env x objective, sorted).
 
-    A comparison rerun for one env x task so keeps the others' rows in ``compare.md``.
+    A comparison rerun for one env x objective so keeps the others' rows in ``compare.md``.
     """
     header: list[str] = []
     rows: list[str] = []
@@ -563,7 +564,7 @@ def collect_tables(output: Path) -> str:
 
 
 __all__ = [
-    "CONTROLLER_FACTORIES", "OPTIMAL", "REFERENCE_NAMES", "SCORES", "TASKS", "TRAINED_DIR",
+    "CONTROLLER_FACTORIES", "OPTIMAL", "REFERENCE_NAMES", "SCORES", "OBJECTIVES", "TRAINED_DIR",
     "TRAJECTORY_FIELDS",
     "Controller", "Episode", "EpisodeScores", "aggregate_runs", "collect_tables", "compare",
     "comparison_record", "evaluate_controller", "group_by_algorithm", "interval_text",

@@ -105,7 +105,7 @@ def _bars(ax: Any, positions: np.ndarray, estimates: list[dict[str, Any]], colou
 
 def _score_panel(ax: Any, comparison: dict[str, Any]) -> None:
     rows = comparison["controllers"]
-    ratio_key = "effort_ratio" if comparison["task"] == "effort" else "time_ratio"
+    ratio_key = "effort_ratio" if comparison["objective"] == "effort" else "time_ratio"
     name = ratio_key.split("_")[0]
     positions = np.arange(len(rows))
     _bars(ax, positions - 0.2, [row["aggregate"]["success_rate"] for row in rows], "C2",
@@ -126,13 +126,13 @@ def _score_panel(ax: Any, comparison: dict[str, Any]) -> None:
 
 
 def plot_comparison(comparison: dict[str, Any], path: Path) -> None:
-    """Write the four-panel comparison figure of one env x task to ``path`` (PNG)."""
+    """Write the four-panel comparison figure of one env x objective to ``path`` (PNG)."""
     fig, axes = plt.subplots(2, 2, figsize=(11, 8))
     _trajectory_panels(axes[0], comparison)
     _schedule_panel(axes[1, 0], comparison)
     _score_panel(axes[1, 1], comparison)
     env = comparison["env_id"].split("/")[-1]
-    fig.suptitle(f"{env}, task {comparison['task']}: RL vs optimal reference "
+    fig.suptitle(f"{env}, objective {comparison['objective']}: RL vs optimal reference "
                  f"({comparison['reference']}, {comparison['optimal_time']:.3f} s)")  # fmt: skip
     fig.tight_layout()
     fig.savefig(path, dpi=110)

@@ -1,20 +1,19 @@
 """The baseline settings, read from rl-zoo3 YAML files shipped in ``baselines/hyperparams``.
 
-One source: the files ``hyperparams/{algo}.yml`` (task "time") and ``{algo}_{task}.yml``
-(other tasks: the diff drive's "effort") are rl-zoo3 hyperparameter files, keyed by the full
+One source: the files ``hyperparams/{algo}.yml`` (objective "time") and ``{algo}_{objective}.yml``
+(other objectives: the diff drive's "effort") are rl-zoo3 hyperparameter files, keyed by the full
 env id, so that ``python -m rl_zoo3.train --algo ppo --env mdi_envs/BlockableManipulator-v0
 --gym-packages mdi_envs -conf baselines/hyperparams/ppo.yml`` trains with the settings that
-``mdi-envs train`` reads here (``get_hyperparameters``). rl-zoo3 looks an entry up by env id
-alone, so a task that needs other settings needs its own file; the task itself travels as the
-env argument ``task`` in ``env_kwargs``. An entry's rl-zoo3 keys map to ours: ``n_envs`` ->
-``num_envs``, ``n_timesteps`` -> ``total_timesteps``, ``normalize: {norm_obs: false,
-norm_reward: true}`` -> ``normalize_reward`` (the only normalization used), ``env_kwargs`` as
-is, ``policy`` must be ``MlpPolicy``; every other key is an SB3 constructor argument
-(``algo_kwargs``). Algorithms: SB3's PPO and SAC and sb3-contrib's TQC and CrossQ on the
-default flattened Box action spaces, and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a
-categorical brake x Gaussian torque policy) on the manipulator's native
-``action_mode="hybrid"`` space ``Tuple(Discrete(2), Box(-1, 1, (1,)))``; rl-zoo3 trains it
-through ``baselines.zoo``. Choices shared by every entry:
+``mdi-envs train`` reads here (``get_hyperparameters``). rl-zoo3 looks an entry up by env id alone,
+so an objective that needs other settings needs its own file; the objective itself travels as the
+env argument ``objective`` in ``env_kwargs``. An entry's rl-zoo3 keys map to ours: ``n_envs`` ->
+``num_envs``, ``n_timesteps`` -> ``total_timesteps``, ``normalize: {norm_obs: false, norm_reward:
+true}`` -> ``normalize_reward`` (the only normalization used), ``env_kwargs`` as is, ``policy``
+must be ``MlpPolicy``; every other key is an SB3 constructor argument (``algo_kwargs``).
+Algorithms: SB3's PPO and SAC and sb3-contrib's TQC and CrossQ on the default flattened Box action
+spaces, and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a categorical brake x Gaussian torque
+policy) on the manipulator's native ``action_mode="hybrid"`` space ``Tuple(Discrete(2), Box(-1, 1,
+(1,)))``; rl-zoo3 trains it through ``baselines.zoo``. Choices shared by every entry:
 
 - ``gamma = 0.99`` for every algorithm. The env's shaping term is
   ``shaping_discount * Phi(s') - Phi(s)`` with Phi = -distance; every entry sets
@@ -41,8 +40,8 @@ through ``baselines.zoo``. Choices shared by every entry:
   algorithm's own learning rate; on "effort" PPO's reward (``goal_weight`` 1000, rewards
   normalized). A SAC gradient step at 2 x 256 costs ~10 ms on this CPU (one thread), TQC and
   CrossQ ~16-18 ms. The 10-step returns are what made SAC learn: with 1-step targets (64
-  copies, ratio 1/16, 10^6 steps) SAC reached 0 % on every task and CrossQ stood still on the
-  robot's time task. Our reading, not tested further: one 0.05 s step of torque changes the
+  copies, ratio 1/16, 10^6 steps) SAC reached 0 % on every objective and CrossQ stood still on the
+  robot's time objective. Our reading, not tested further: one 0.05 s step of torque changes the
   shaped reward too little for a 1-step target to carry the gain of a maneuver.
 - Budgets, the ones of the shipped policies (``baselines/trained``): PPO 10^7 steps on the
   manipulator, 4 x 10^6 on diff drive "time", 5 x 10^6 on "effort", HybridPPO 5 x 10^6; the
@@ -82,8 +81,8 @@ HYPERPARAMS_DIR = Path(__file__).parent / "hyperparams"
 DEFAULT_SEED = 0
 """The seed of a run when none is given (rl-zoo3: ``--seed 0``)."""
 
-DEFAULT_TASKS = {MANIPULATOR: "time", DIFF_DRIVE: "time"}
-"""The task used when none is given (the manipulator has only "time")."""
+DEFAULT_OBJECTIVES = {MANIPULATOR: "time", DIFF_DRIVE: "time"}
+"""The objective used when none is given (the manipulator has only "time")."""
 
 _NORMALIZE_REWARD = {"norm_obs": False, "norm_reward": True}
 """rl-zoo3's ``normalize`` value of the entries with ``normalize_reward``."""
@@ -97,12 +96,12 @@ def canonical_algorithm(name: str) -> str:
     return {algo.lower(): algo for algo in ALGORITHMS}.get(name.lower(), name)
 
 
-def hyperparameter_file(algo: str, task: str = "time") -> Path:
-    """The rl-zoo3 file of ``algo``, ``task``: ``{algo}.yml`` ("time") or ``{algo}_{task}.yml``.
+def hyperparameter_file(algo: str, objective: str = "time") -> Path:
+    """The rl-zoo3 file of ``algo``, ``objective``: ``{algo}.yml`` or ``{algo}_{objective}.yml``.
 
     The path exists only for the combinations of the table (``hyperparameter_table``).
     """
-    name = canonical_algorithm(algo).lower() + ("" if task == "time" else f"_{task}")
+    name = canonical_algorithm(algo).lower() + ("" if objective == "time" else f"_{objective}")
     return HYPERPARAMS_DIR / f"{name}.yml"
 
 
@@ -131,13 +130,13 @@ def hyperparameter_table() -> dict[tuple[str, str, str], dict[str, Any]]:
     """The table read from ``HYPERPARAMS_DIR`` (once per process; the object is shared).
 
     Returns:
-        (env id, task, algorithm) -> {"num_envs", "total_timesteps", "seed", "algo_kwargs"
+        (env id, objective, algorithm) -> {"num_envs", "total_timesteps", "seed", "algo_kwargs"
         (SB3 constructor arguments), "env_kwargs" (``gym.make`` arguments), "normalize_reward"
         (train on rewards scaled by ``VecNormalize``)}. The algorithm is the file name's first
-        part, the task the entry's ``env_kwargs["task"]`` ("time" when absent).
+        part, the objective the entry's ``env_kwargs["objective"]`` ("time" when absent).
 
     Raises:
-        ValueError: an entry in a file whose name does not match its algorithm and task.
+        ValueError: an entry in a file whose name does not match its algorithm and objective.
     """
     import yaml
 
@@ -146,28 +145,28 @@ def hyperparameter_table() -> dict[tuple[str, str, str], dict[str, Any]]:
         algo = canonical_algorithm(path.stem.split("_")[0])
         for env_id, zoo in yaml.safe_load(path.read_text()).items():
             entry = entry_from_zoo(zoo)
-            task = str(entry["env_kwargs"].get("task", "time"))
-            if hyperparameter_file(algo, task) != path:
-                raise ValueError(f"{path.name}: the {env_id} entry (task {task!r}) belongs in "
-                                 f"{hyperparameter_file(algo, task).name}")  # fmt: skip
-            table[(env_id, task, algo)] = entry
+            objective = str(entry["env_kwargs"].get("objective", "time"))
+            if hyperparameter_file(algo, objective) != path:
+                raise ValueError(f"{path.name}: the {env_id} entry (objective {objective!r}) "
+                                 f"belongs in {hyperparameter_file(algo, objective).name}")
+            table[(env_id, objective, algo)] = entry
     return table
 
 
-def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict[str, Any]:
+def get_hyperparameters(env_id: str, algo: str, objective: str | None = None) -> dict[str, Any]:
     """A deep copy of the table entry.
 
     Args:
         env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
         algo: "PPO", "SAC" or "HybridPPO" (case-insensitive; HybridPPO: manipulator only).
-        task: "time" or "effort" (diff drive only); default ``DEFAULT_TASKS[env_id]``.
+        objective: "time" or "effort" (diff drive only); default ``DEFAULT_OBJECTIVES[env_id]``.
 
     Raises:
         KeyError: no entry for this combination (the message lists the known keys).
     """
     table = hyperparameter_table()
-    task = DEFAULT_TASKS.get(env_id) if task is None else task
-    key = (env_id, str(task), canonical_algorithm(algo))
+    objective = DEFAULT_OBJECTIVES.get(env_id) if objective is None else objective
+    key = (env_id, str(objective), canonical_algorithm(algo))
     if key not in table:
         known = ", ".join(" ".join(k) for k in table)
         raise KeyError(f"no hyperparameters for {' '.join(map(str, key))}; known: {known}")
@@ -175,7 +174,7 @@ def get_hyperparameters(env_id: str, algo: str, task: str | None = None) -> dict
 
 
 __all__ = [
-    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_SEED", "DEFAULT_TASKS", "HYPERPARAMS_DIR",
+    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_SEED", "DEFAULT_OBJECTIVES", "HYPERPARAMS_DIR",
     "canonical_algorithm", "entry_from_zoo", "get_hyperparameters", "hyperparameter_file",
     "hyperparameter_table",
 ]

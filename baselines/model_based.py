@@ -1,13 +1,13 @@
 """Model-based controller rows of the comparison: the shrinking-horizon MPC (``optimal.mpc``).
 
-``mpc_controller(env_id, task)`` plays ``ShrinkingHorizonMPC`` around the task's reference in
-the env configured like the reference's open-loop replay (one env step per transcription
-interval, ``env_options``), with twice the reference's steps for time-optimal tasks (a
-perturbed start may need longer than the optimum; the effort tasks keep their fixed horizon).
-One controller serves every episode of a row, so the NLPs it built are reused.
+``mpc_controller(env_id, objective)`` plays ``ShrinkingHorizonMPC`` around the reference of (env
+id, objective) in the env configured like the reference's open-loop replay (one env step per
+transcription interval, ``env_options``), with twice the reference's steps for time-optimal
+objectives (a perturbed start may need longer than the optimum; the effort objectives keep their
+fixed horizon). One controller serves every episode of a row, so the NLPs it built are reused.
 ``mdi-envs compare ... --mpc`` adds it; it is not in ``baselines.compare.CONTROLLER_FACTORIES``,
-which every comparison and test plays, because it costs 0.1-1 s of compute per env step.
-Needs CasADi (the ``optimal`` extra); without it the row is left out.
+which every comparison and test plays, because it costs 0.1-1 s of compute per env step. Needs
+CasADi (the ``optimal`` extra); without it the row is left out.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ MPC = "MPC (shrinking horizon)"
 """The label of the MPC rows."""
 
 
-def mpc_controller(env_id: str, task: str) -> Controller | None:
-    """The MPC around the reference of (env id, task); None without a reference or CasADi."""
-    name = REFERENCE_NAMES.get((env_id, task))
+def mpc_controller(env_id: str, objective: str) -> Controller | None:
+    """The MPC around the reference of (env id, objective); None without a reference or CasADi."""
+    name = REFERENCE_NAMES.get((env_id, objective))
     if name is None or importlib.util.find_spec("casadi") is None:
         return None
     from optimal.mpc import ShrinkingHorizonMPC

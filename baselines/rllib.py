@@ -18,7 +18,7 @@ minibatch, rollout of ``n_steps x n_envs`` per iteration, gradient clipping, no 
 2 x 64 tanh networks (policy and value separate), no KL penalty (SB3 has none), the env
 arguments as ``env_config`` and ``n_envs`` copies per env runner (RLlib's own
 ``gym.make_vec``, not the batched adapter). Not translated: the "effort" entry's reward
-normalization (SB3's ``VecNormalize``), so RLlib on that task trains on the raw rewards.
+normalization (SB3's ``VecNormalize``), so RLlib on that objective trains on the raw rewards.
 
 ``python -m baselines.rllib mdi_envs/BlockableManipulator-v0 --iterations 1`` trains (locally,
 or on a cluster with ``--address``) and prints each iteration's return and steps.
@@ -77,14 +77,14 @@ def register_env(env_id: str) -> str:
     return env_id
 
 
-def ppo_config(env_id: str, task: str | None = None, *, num_env_runners: int = 0,
+def ppo_config(env_id: str, objective: str | None = None, *, num_env_runners: int = 0,
                num_envs_per_env_runner: int | None = None,
                train_batch_size: int | None = None, minibatch_size: int | None = None,
                num_epochs: int | None = None) -> Any:  # fmt: skip
     """RLlib's ``PPOConfig`` for ``env_id`` with the shipped PPO settings (``env_id`` registered).
 
     Args:
-        env_id: a mission env id. task: "time" or "effort" (diff drive), as ``mdi-envs train``.
+        env_id: a mission env id. objective: "time" or "effort" (diff drive), as ``mdi-envs train``.
         num_env_runners: remote env-runner actors (0: sample in the driver's process).
         num_envs_per_env_runner, train_batch_size, minibatch_size, num_epochs: overrides of the
             entry's copies, steps per iteration, minibatch and epochs (tests shrink them).
@@ -96,7 +96,7 @@ def ppo_config(env_id: str, task: str | None = None, *, num_env_runners: int = 0
 
     from baselines.hyperparameters import get_hyperparameters
 
-    entry = get_hyperparameters(env_id, "PPO", task)
+    entry = get_hyperparameters(env_id, "PPO", objective)
     sb3 = entry["algo_kwargs"]
     copies = entry["num_envs"] if num_envs_per_env_runner is None else num_envs_per_env_runner
     batch = sb3["n_steps"] * entry["num_envs"] if train_batch_size is None else train_batch_size
@@ -148,7 +148,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m baselines.rllib",
                                      description=__doc__.split("\n")[0])  # fmt: skip
     parser.add_argument("env_id", help="a mission env id, e.g. mdi_envs/BlockableManipulator-v0")
-    parser.add_argument("--task", choices=("time", "effort"), default=None)
+    parser.add_argument("--objective", choices=("time", "effort"), default=None)
     parser.add_argument("--iterations", type=int, default=1)
     parser.add_argument("--num-env-runners", type=int, default=0)
     parser.add_argument("--address", default=None,
@@ -157,7 +157,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     check_env_id(args.env_id)
     ray.init(address=args.address, include_dashboard=False)
     try:
-        train_rllib(ppo_config(args.env_id, args.task, num_env_runners=args.num_env_runners),
+        train_rllib(ppo_config(args.env_id, args.objective, num_env_runners=args.num_env_runners),
                     args.iterations, log=print)  # fmt: skip
     finally:
         ray.shutdown()

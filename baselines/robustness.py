@@ -1,6 +1,6 @@
 """Robustness of every controller: start perturbations and a model the controller does not know.
 
-For (env id, task) each controller -- the optimal reference open loop, optionally the MPC
+For (env id, objective) each controller -- the optimal reference open loop, optionally the MPC
 (``baselines.model_based``), and every trained seed of every algorithm (``baselines/trained``)
 -- is played from ``num_seeds`` perturbed starts under each condition:
 
@@ -13,7 +13,7 @@ For (env id, task) each controller -- the optimal reference open loop, optionall
 
 Reported per controller and condition: the success rate (mean over a trained algorithm's seeds,
 with the per-seed rates) and, over the successes, the time and effort ratios to the reference.
-``python -m baselines.robustness ENV_ID|all [--task T] [--seeds N] [--mpc]`` writes
+``python -m baselines.robustness ENV_ID|all [--objective T] [--seeds N] [--mpc]`` writes
 ``robustness_ENV_TASK.json``, ``.png`` (success against the perturbation scale, one curve per
 controller; success under each mismatch) and ``robustness.md`` (the table of every
 ``robustness_*.json`` in the output folder). ``--controllers LABEL ... [--scales ...]
@@ -91,18 +91,18 @@ MISMATCHES: dict[str, tuple[tuple[str, Callable[[], Any]], ...]] = {
 """Env id -> (label, parameters factory) of the env's model mismatches."""
 
 
-def controllers_for(env_id: str, task: str, mpc: bool = False,
+def controllers_for(env_id: str, objective: str, mpc: bool = False,
                     trained_dir: Path = TRAINED_DIR) -> list[tuple[str, list[Controller]]]:
     """(label, runs) per controller: untrained ones with one run, trained ones per seed."""
-    rows = [(c.label, [c]) for c in registered_controllers(env_id, task)]
+    rows = [(c.label, [c]) for c in registered_controllers(env_id, objective)]
     if mpc:
         from baselines.model_based import mpc_controller
 
-        controller = mpc_controller(env_id, task)
+        controller = mpc_controller(env_id, objective)
         if controller is None:
             raise RuntimeError("the MPC needs CasADi (pip install 'mdi-envs[optimal]')")
         rows.append((controller.label, [controller]))
-    for algo, paths in group_by_algorithm(shipped_policies(env_id, task, trained_dir)).items():
+    for algo, paths in group_by_algorithm(shipped_policies(env_id, objective, trained_dir)).items():
         rows.append((algo, [load_policy(path)[0] for path in paths]))
     return rows
 
@@ -116,14 +116,14 @@ class EpisodeRecord:
     """One finished episode of the study, as kept in the episodes file (no trajectory).
 
     Attributes:
-        env_id, task: the study. controller: its label. run: index of the controller's run
+        env_id, objective: the study. controller: its label. run: index of the controller's run
         (a trained algorithm's seed). condition: the condition's label. seed: the reset seed.
         is_success, elapsed_time [s], effort [N^2 m^2 s], solver_failures, compute_per_step
         [s]: as ``baselines.compare.Episode``.
     """
 
     env_id: str
-    task: str
+    objective: str
     controller: str
     run: int
     condition: str
@@ -135,9 +135,9 @@ class EpisodeRecord:
     compute_per_step: float
 
 
-def read_episodes(path: Path | None, env_id: str, task: str
+def read_episodes(path: Path | None, env_id: str, objective: str
                   ) -> dict[tuple[str, int, str, int], EpisodeRecord]:  # fmt: skip
-    """{(controller, run, condition, seed): record} of the study (env id, task) in ``path``.
+    """{(controller, run, condition, seed): record} of the study (env id, objective) in ``path``.
 
     A missing file is an empty one; a last line cut short (a run killed while writing) is
     skipped.
@@ -150,7 +150,7 @@ def read_episodes(path: Path | None, env_id: str, task: str
             record = EpisodeRecord(**json.loads(line))
         except (json.JSONDecodeError, TypeError):
             continue
-        if (record.env_id, record.task) == (env_id, task):
+        if (record.env_id, record.objective) == (env_id, objective):
             records[(record.controller, record.run, record.condition, record.seed)] = record
     return records
 
@@ -165,7 +165,7 @@ def _append(path: Path, record: EpisodeRecord) -> None:
         stream.write(json.dumps(dataclasses.asdict(record)).encode() + b"\n")
 
 
-def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
+def robustness(env_id: str, objective: str, num_seeds: int = 20, mpc: bool = False,
                scales: Sequence[float] = SCALES, trained_dir: Path = TRAINED_DIR,
                log: Callable[[str], None] | None = None,
                mismatches: bool | Sequence[str] = True,
@@ -182,15 +182,15 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
     stopped.
 
     Returns:
-        {"env_id", "task", "reference", "optimal_time" [s], "optimal_effort", "seeds",
+        {"env_id", "objective", "reference", "optimal_time" [s], "optimal_effort", "seeds",
         "conditions": [{"label", "scale", "mismatch"}], "controllers": [{"label", "runs",
         "results": [{"condition", "success_rate" (mean over runs), "run_success_rates",
         "time_ratio", "effort_ratio" (means over runs with successes, None without)}]}]}.
     """
-    if (env_id, task) not in REFERENCE_NAMES:
-        raise ValueError(f"no optimal reference for {env_id} task {task!r}")
+    if (env_id, objective) not in REFERENCE_NAMES:
+        raise ValueError(f"no optimal reference for {env_id} objective {objective!r}")
     say = log or (lambda _: None)
-    reference = load_reference(REFERENCE_NAMES[(env_id, task)])
+    reference = load_reference(REFERENCE_NAMES[(env_id, objective)])
     optimal_time, optimal_effort = reference.final_time, reference_effort(reference)
     conditions = [{"label": f"perturbation {scale:g}", "scale": float(scale), "mismatch": None}
                   for scale in scales]
@@ -204,13 +204,13 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
             raise ValueError(f"unknown mismatch {unknown} for {env_id}; known: {list(factories)}")
     conditions += [{"label": label, "scale": DEFAULT_SCALE, "mismatch": label}
                    for label in factories if label in mismatch_labels]
-    available = controllers_for(env_id, task, mpc, trained_dir)
-    require_known_labels(only, [label for label, _ in available], env_id, task)
+    available = controllers_for(env_id, objective, mpc, trained_dir)
+    require_known_labels(only, [label for label, _ in available], env_id, objective)
     playing = [(label, runs) for label, runs in available if only is None or label in only]
     bar = tqdm(total=num_seeds * len(conditions) * sum(len(runs) for _, runs in playing),
-               desc=f"{env_id.split('/')[-1]} {task}", unit="episode", mininterval=10.0,
+               desc=f"{env_id.split('/')[-1]} {objective}", unit="episode", mininterval=10.0,
                disable=not show_bar)
-    finished = read_episodes(episodes_path, env_id, task) if resume else {}
+    finished = read_episodes(episodes_path, env_id, objective) if resume else {}
     rows = []
     for label, runs in playing:
         results = []
@@ -228,7 +228,7 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                     if record is None:
                         episode = play(env_id, controller.make_policy, seed, True, **kwargs)
                         record = EpisodeRecord(
-                            env_id, task, *key, episode.is_success, episode.elapsed_time,
+                            env_id, objective, *key, episode.is_success, episode.elapsed_time,
                             episode.effort, episode.solver_failures, episode.compute_per_step)
                         if episodes_path is not None:
                             _append(episodes_path, record)
@@ -242,11 +242,11 @@ def robustness(env_id: str, task: str, num_seeds: int = 20, mpc: bool = False,
                 values = [s[ratio] for s in summaries if s[ratio] is not None]
                 result[ratio] = float(np.mean(values)) if values else None
             results.append(result)
-            say(f"{env_id} {task} {label} [{condition['label']}]: success "
+            say(f"{env_id} {objective} {label} [{condition['label']}]: success "
                 f"{result['success_rate']:.0%} over {len(runs)} run(s) x {num_seeds} starts")
         rows.append({"label": label, "runs": len(runs), "results": results})
     bar.close()
-    return {"env_id": env_id, "task": task, "reference": reference.name,
+    return {"env_id": env_id, "objective": objective, "reference": reference.name,
             "optimal_time": optimal_time, "optimal_effort": optimal_effort,
             "seeds": num_seeds, "conditions": conditions, "controllers": rows}
 
@@ -255,13 +255,13 @@ def merge_studies(old: dict[str, Any], new: dict[str, Any],
                   shipped: Collection[str] | None = None) -> dict[str, Any]:
     """``old`` with the (controller, condition) results of ``new`` added or replaced.
 
-    Both must be of the same env, task and number of starts. Conditions keep their order
+    Both must be of the same env, objective and number of starts. Conditions keep their order
     (scales ascending, then the mismatches); a controller without a result for some condition
     shows none there. With ``shipped`` (the algorithms that have trained policies now), an
     old row of another trained algorithm (``ALGORITHMS``) is dropped: its policies were
     withdrawn.
     """
-    for key in ("env_id", "task", "seeds"):
+    for key in ("env_id", "objective", "seeds"):
         if old[key] != new[key]:
             raise ValueError(f"cannot merge studies of different {key}: {old[key]} and "
                              f"{new[key]}")
@@ -281,12 +281,12 @@ def merge_studies(old: dict[str, Any], new: dict[str, Any],
 
 
 def markdown_table(studies: Sequence[dict[str, Any]]) -> str:
-    """One row per env x task x controller; success (ratio over the successes) per condition."""
+    """One row per env x objective x controller; success (ratio over successes) per condition."""
     lines: list[str] = []
     for study in studies:
         labels = [c["label"] for c in study["conditions"]]
-        ratio_name = "time" if study["task"] == "time" else "effort"
-        lines += [f"\n{study['env_id']} {study['task']} ({study['seeds']} starts per run; "
+        ratio_name = "time" if study["objective"] == "time" else "effort"
+        lines += [f"\n{study['env_id']} {study['objective']} ({study['seeds']} starts per run; "
                   f"success, {ratio_name}/optimal over the successes)\n",
                   "| controller | runs | " + " | ".join(labels) + " |",
                   "|---|---|" + "---|" * len(labels)]
@@ -334,7 +334,7 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
     left.set_xlabel("start perturbation scale [rad, rad/s, m, m/s]")
     left.set_ylabel("success [%]")
     left.set_ylim(-3, 103)
-    left.set_title(f"{study['env_id'].split('/')[-1]} {study['task']}: perturbed starts")
+    left.set_title(f"{study['env_id'].split('/')[-1]} {study['objective']}: perturbed starts")
     left.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2)
     right.set_xticks(np.arange(len(mismatched)) + width * (len(study["controllers"]) - 1) / 2)
     right.set_xticklabels([c["label"] for c in mismatched], fontsize=8)
@@ -349,11 +349,11 @@ def plot_robustness(study: dict[str, Any], path: Path) -> Path:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m baselines.robustness ENV_ID|all [--task T] [--seeds N] [--mpc]``."""
+    """``python -m baselines.robustness ENV_ID|all [--objective T] [--seeds N] [--mpc]``."""
     parser = argparse.ArgumentParser(prog="python -m baselines.robustness",
                                      description=(__doc__ or "").split("\n\n")[0])
     parser.add_argument("env_id", choices=[MANIPULATOR, DIFF_DRIVE, "all"])
-    parser.add_argument("--task", choices=("time", "effort"), default=None)
+    parser.add_argument("--objective", choices=("time", "effort"), default=None)
     parser.add_argument("--seeds", type=int, default=20, help="perturbed starts per run")
     parser.add_argument("--scales", type=float, nargs="*", default=list(SCALES),
                         help="start perturbation scales (none: play no scale)")
@@ -374,25 +374,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.seeds < 1:
         parser.error(f"--seeds must be >= 1, got {args.seeds}")
     jobs = [key for key in REFERENCE_NAMES
-            if args.env_id in ("all", key[0]) and args.task in (None, key[1])]
+            if args.env_id in ("all", key[0]) and args.objective in (None, key[1])]
     if not jobs:
-        parser.error(f"{args.env_id} has no task {args.task!r}")
+        parser.error(f"{args.env_id} has no objective {args.objective!r}")
     args.output.mkdir(parents=True, exist_ok=True)
-    for env_id, task in jobs:
-        study = robustness(env_id, task, args.seeds, args.mpc, args.scales, args.trained,
+    for env_id, objective in jobs:
+        study = robustness(env_id, objective, args.seeds, args.mpc, args.scales, args.trained,
                            log=lambda line: tqdm.write(line, file=sys.stderr),
                            mismatches=(args.mismatches if args.mismatch and args.mismatches
                                        else args.mismatch),
                            only=args.controllers, show_bar=True,
                            episodes_path=args.output / EPISODES_FILE, resume=args.resume)
-        stem = f"robustness_{env_id.split('/')[-1]}_{task}"
+        stem = f"robustness_{env_id.split('/')[-1]}_{objective}"
         path = args.output / f"{stem}.json"
         if args.controllers is not None and path.exists():
             study = merge_studies(json.loads(path.read_text()), study,
-                                  shipped_algorithms(env_id, task, args.trained))
+                                  shipped_algorithms(env_id, objective, args.trained))
         path.write_text(json.dumps(study, indent=1))
         plot_robustness(study, args.output / f"{stem}.png")
-    # every study in the folder, so that rerunning one env x task keeps the others' rows
+    # every study in the folder, so that rerunning one env x objective keeps the others' rows
     studies = [json.loads(path.read_text())
                for path in sorted(args.output.glob("robustness_*.json"))]
     table = markdown_table(studies)

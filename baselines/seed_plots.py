@@ -1,6 +1,6 @@
 """The figure over training seeds of ``baselines.compare``: performance profiles and curves.
 
-Three panels per env x task, drawn with ``rliable.plot_utils``: the performance profile of the
+Three panels per env x objective, drawn with ``rliable.plot_utils``: the performance profile of the
 success rate (fraction of runs whose success rate over the perturbed starts exceeds tau), the
 profile of the optimality score (optimum / the run's mean time or effort over its successes,
 1 = optimal; 0 for a run without success), and the training curves: the IQM over seeds of the
@@ -29,9 +29,9 @@ TAUS = np.linspace(0.0, 1.0, 101)
 """Profile thresholds (success rate and optimality score are both in [0, 1])."""
 
 
-def optimality_score(run: dict[str, Any], task: str) -> float:
-    """Optimum / the run's mean over its successes (time or effort by ``task``); 0 if none."""
-    ratio = run["summary"]["effort_ratio" if task == "effort" else "time_ratio"]
+def optimality_score(run: dict[str, Any], objective: str) -> float:
+    """Optimum / the run's mean over its successes (time or effort by ``objective``); 0 if none."""
+    ratio = run["summary"]["effort_ratio" if objective == "effort" else "time_ratio"]
     return 0.0 if ratio is None else 1.0 / ratio
 
 
@@ -43,7 +43,7 @@ def run_curve(config: dict[str, Any], trained_dir: Path) -> tuple[np.ndarray, np
     """
     from baselines.train import read_episodes, run_name, training_curve
 
-    stem = run_name(config["env_id"], config["task"], config["algo"], int(config["seed"]))
+    stem = run_name(config["env_id"], config["objective"], config["algo"], int(config["seed"]))
     curve, episodes = (Path(trained_dir) / f"{stem}_{kind}.csv" for kind in ("curve", "episodes"))
     if curve.exists():
         with curve.open() as handle:
@@ -104,21 +104,21 @@ def _curve_panel(ax: Any, comparison: dict[str, Any], trained_dir: Path,
 
 
 def plot_seeds(comparison: dict[str, Any], path: Path, trained_dir: Path) -> None:
-    """Write the three-panel figure over runs of one env x task to ``path`` (PNG)."""
+    """Write the three-panel figure over runs of one env x objective to ``path`` (PNG)."""
     rows = comparison["controllers"]
     colours = _colours(rows)
-    task = comparison["task"]
+    objective = comparison["objective"]
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
     _profile_panel(axes[0], {row["label"]: [run["summary"]["success_rate"] for run in row["runs"]]
                              for row in rows}, colours, "success rate tau")  # fmt: skip
     axes[0].set_title("performance profile: success rate", fontsize=9)
-    _profile_panel(axes[1], {row["label"]: [optimality_score(run, task) for run in row["runs"]]
+    _profile_panel(axes[1], {row["label"]: [optimality_score(run, objective) for run in row["runs"]]
                              for row in rows}, colours,
-                   f"optimal / achieved {task if task == 'effort' else 'time'} tau")  # fmt: skip
+                   f"optimal / achieved {'effort' if objective == 'effort' else 'time'} tau")
     axes[1].set_title("performance profile: optimality (0 = no success)", fontsize=9)
     _curve_panel(axes[2], comparison, trained_dir, colours)
     env = comparison["env_id"].split("/")[-1]
-    fig.suptitle(f"{env}, task {task}: runs over training seeds "
+    fig.suptitle(f"{env}, objective {objective}: runs over training seeds "
                  f"({len(comparison['seeds'])} perturbed starts per run)")  # fmt: skip
     fig.tight_layout()
     fig.savefig(path, dpi=110)

@@ -1,13 +1,14 @@
-"""The seed x algorithm x task grid of ``baselines.train`` through Ray Tune (``mdi-envs sweep``).
+"""The seed x algorithm x objective grid of ``baselines.train`` (``mdi-envs sweep``, Ray Tune).
 
-One Tune trial per (env id, task, algorithm, seed) that the table has (``baselines/hyperparams``)
-and whose ``STEM.json`` is not yet in ``output``: a finished run is never rerun, so an
-interrupted sweep resumes by running the same command again, and runs made by ``mdi-envs
-train`` into the same folder count as finished. Each trial calls ``baselines.train.train`` in a
-Ray worker process (which imports ``mdi_envs`` and so registers the env ids there) and writes
-the usual ``STEM.zip``, ``STEM.json``, ``STEM_episodes.csv``, ``STEM.png`` into ``output``,
-the folder ``mdi-envs compare --trained OUTPUT`` aggregates over seeds. Tune's own records
-(trial logs, errors, the driver's experiment state) go to ``output/ray_results``.
+One Tune trial per (env id, objective, algorithm, seed) that the table has
+(``baselines/hyperparams``) and whose ``STEM.json`` is not yet in ``output``: a finished run is
+never rerun, so an interrupted sweep resumes by running the same command again, and runs made by
+``mdi-envs train`` into the same folder count as finished. Each trial calls
+``baselines.train.train`` in a Ray worker process (which imports ``mdi_envs`` and so registers the
+env ids there) and writes the usual ``STEM.zip``, ``STEM.json``, ``STEM_episodes.csv``,
+``STEM.png`` into ``output``, the folder ``mdi-envs compare --trained OUTPUT`` aggregates over
+seeds. Tune's own records (trial logs, errors, the driver's experiment state) go to
+``output/ray_results``.
 
 Where it runs: without ``address`` a local Ray instance on this machine's cores
 (``num_cpus``, default all), ``cpus_per_trial`` cores reserved per trial (one: torch runs on
@@ -35,32 +36,32 @@ from baselines.hyperparameters import canonical_algorithm, hyperparameter_table
 
 @dataclass(frozen=True)
 class Trial:
-    """One run of the grid: ``train(env_id, algo, task, seed)``."""
+    """One run of the grid: ``train(env_id, algo, objective, seed)``."""
 
     env_id: str
-    task: str
+    objective: str
     algo: str
     seed: int
 
     @property
     def stem(self) -> str:
         """The run's file stem (``baselines.train.run_name``)."""
-        return f"{self.env_id.split('/')[-1]}_{self.task}_{self.algo.lower()}_seed{self.seed}"
+        return f"{self.env_id.split('/')[-1]}_{self.objective}_{self.algo.lower()}_seed{self.seed}"
 
 
 def grid(algos: Sequence[str], seeds: Sequence[int], env_ids: Sequence[str] | None = None,
-         tasks: Sequence[str] | None = None) -> list[Trial]:  # fmt: skip
-    """Every (env id, task, algorithm) of the table matching the filters, times ``seeds``.
+         objectives: Sequence[str] | None = None) -> list[Trial]:  # fmt: skip
+    """Every (env id, objective, algorithm) of the table matching the filters, times ``seeds``.
 
     Args:
         algos: algorithm names (case-insensitive). seeds: training seeds.
-        env_ids, tasks: keep only these (None: all).
+        env_ids, objectives: keep only these (None: all).
     """
     wanted = {canonical_algorithm(a) for a in algos}
-    return [Trial(env_id, task, algo, int(seed))
-            for (env_id, task, algo) in hyperparameter_table()
+    return [Trial(env_id, objective, algo, int(seed))
+            for (env_id, objective, algo) in hyperparameter_table()
             if algo in wanted and (env_ids is None or env_id in env_ids)
-            and (tasks is None or task in tasks)
+            and (objectives is None or objective in objectives)
             for seed in seeds]  # fmt: skip
 
 
@@ -79,7 +80,7 @@ def run_trial(config: dict[str, Any]) -> dict[str, Any]:
 
     trial, options = config["trial"], dict(config["train"])
     output = Path(options.pop("output"))
-    path = train(trial["env_id"], trial["algo"], task=trial["task"], seed=trial["seed"],
+    path = train(trial["env_id"], trial["algo"], objective=trial["objective"], seed=trial["seed"],
                  output=output, progress_bar=False, **options)  # fmt: skip
     record = json.loads(path.with_suffix(".json").read_text())
     evaluation = record["evaluation"]

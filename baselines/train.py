@@ -1,6 +1,6 @@
 """Train one SB3 baseline and save it next to its exact config, episode log and curves.
 
-``train("mdi_envs/DiffDriveRobot-v0", "PPO", task="effort", output=Path("results/baselines"))``
+``train("mdi_envs/DiffDriveRobot-v0", "PPO", objective="effort", output=Path("results/baselines"))``
 checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched env through the
 ``MoreauJeanVecEnv`` adapter wrapped in ``VecMonitor`` (and, for entries with
 ``normalize_reward``, in ``VecNormalize`` on the rewards only), trains with the table's settings
@@ -9,7 +9,7 @@ checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched 
 
 - ``STEM.zip``: the SB3 model (``PPO.load``/``SAC.load``/``HybridPPO.load``, the class from
   ``algorithm_class(config["algo"])``);
-- ``STEM.json``: env id, task, algorithm, seed, the exact SB3 and env arguments, budget,
+- ``STEM.json``: env id, objective, algorithm, seed, the exact SB3 and env arguments, budget,
   package versions, git commit, wall time, training and evaluation scores;
 - ``STEM_episodes.csv``: one row per finished training episode (timesteps, return, length,
   success, elapsed time [s], effort [N^2 m^2 s]); large, kept local;
@@ -19,7 +19,8 @@ checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched 
 - ``STEM.png``: episode return and success rate vs environment steps;
 - ``tensorboard/STEM_1/``: SB3's TensorBoard logs (``tensorboard --logdir OUTPUT/tensorboard``);
 
-with STEM = ``{env name}_{task}_{algo}_seed{seed}``, e.g. ``DiffDriveRobot-v0_effort_ppo_seed0``.
+with STEM = ``{env name}_{objective}_{algo}_seed{seed}``, e.g.
+``DiffDriveRobot-v0_effort_ppo_seed0``.
 
 The algorithm names and their classes are in ``baselines.hyperparameters`` (``ALGORITHMS``,
 ``ALGORITHM_CLASSES``): SB3's PPO and SAC, sb3-contrib's TQC and CrossQ, and ``HybridPPO``
@@ -73,9 +74,9 @@ class EpisodeLog(BaseCallback):
         return True
 
 
-def run_name(env_id: str, task: str, algo: str, seed: int) -> str:
+def run_name(env_id: str, objective: str, algo: str, seed: int) -> str:
     """The file stem of a run, e.g. ``BlockableManipulator-v0_time_ppo_seed0``."""
-    return f"{env_id.split('/')[-1]}_{task}_{algo.lower()}_seed{seed}"
+    return f"{env_id.split('/')[-1]}_{objective}_{algo.lower()}_seed{seed}"
 
 
 def algorithm_class(algo: str) -> Any:
@@ -130,7 +131,7 @@ def check_single_env(env_id: str, env_kwargs: dict[str, Any]) -> None:
 def train(
     env_id: str,
     algo: str,
-    task: str | None = None,
+    objective: str | None = None,
     seed: int | None = None,
     total_timesteps: int | None = None,
     output: Path = Path("results/baselines"),
@@ -147,7 +148,7 @@ def train(
     Args:
         env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
         algo: "PPO", "SAC" or "HybridPPO" (case-insensitive; ``ALGORITHMS``).
-        task: "time" or "effort" (diff drive); default the env's "time".
+        objective: "time" or "effort" (diff drive); default the env's "time".
         seed: the run's seed (SB3's ``seed``: torch, the action noise and env copy i's
             start states from seed + i); default the table's.
         total_timesteps: environment steps to train (summed over copies); default the table's.
@@ -167,9 +168,9 @@ def train(
     from baselines.vec_env import make_vec_env
 
     torch.set_num_threads(int(torch_threads))
-    entry = get_hyperparameters(env_id, algo, task)
+    entry = get_hyperparameters(env_id, algo, objective)
     algo = canonical_algorithm(algo)
-    task = entry["env_kwargs"].get("task", "time")
+    objective = entry["env_kwargs"].get("objective", "time")
     seed = entry["seed"] if seed is None else int(seed)
     total_timesteps = entry["total_timesteps"] if total_timesteps is None else total_timesteps
     num_envs = entry["num_envs"] if num_envs is None else int(num_envs)
@@ -179,7 +180,7 @@ def train(
         progress_bar = sys.stderr.isatty()
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)
-    stem = run_name(env_id, task, algo, seed)
+    stem = run_name(env_id, objective, algo, seed)
 
     check_single_env(env_id, env_kwargs)
     venv = VecMonitor(make_vec_env(env_id, num_envs, **env_kwargs))
@@ -203,7 +204,7 @@ def train(
     write_curve(log.rows, output / f"{stem}_curve.csv")
     recent = log.rows[-100:]
     config = {
-        "env_id": env_id, "task": task, "algo": algo, "seed": seed,
+        "env_id": env_id, "objective": objective, "algo": algo, "seed": seed,
         "num_envs": num_envs, "total_timesteps": total_timesteps,
         "normalize_reward": entry["normalize_reward"],
         "num_timesteps": int(model.num_timesteps),
@@ -218,7 +219,7 @@ def train(
         "evaluation": evaluation,
         "versions": versions(), "commit": git_commit(),
         "date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-        "command": f"mdi-envs train {env_id} {algo} --task {task} --seed {seed} "
+        "command": f"mdi-envs train {env_id} {algo} --objective {objective} --seed {seed} "
                    f"--timesteps {total_timesteps} --num-envs {num_envs}"
                    + (" (plus algo_overrides)" if algo_overrides else ""),
     }

@@ -15,7 +15,7 @@ Example::
     from stable_baselines3.common.vec_env import VecMonitor
     from baselines.vec_env import MoreauJeanVecEnv, make_vec_env
 
-    venv = VecMonitor(make_vec_env("mdi_envs/DiffDriveRobot-v0", num_envs=64, task="effort"))
+    venv = VecMonitor(make_vec_env("mdi_envs/DiffDriveRobot-v0", num_envs=64, objective="effort"))
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def make_vec_env(env_id: str, num_envs: int, **env_kwargs: Any) -> MoreauJeanVec
     Args:
         env_id: a registered ``mdi_envs/...`` id.
         num_envs: the number of copies N.
-        **env_kwargs: environment arguments (e.g. ``task="effort"``, ``shaping_discount``).
+        **env_kwargs: environment arguments (e.g. ``objective="effort"``, ``shaping_discount``).
     """
     venv = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point",
                         **env_kwargs)  # fmt: skip
@@ -62,7 +62,7 @@ class MoreauJeanVecEnv(VecEnv):
     Seeding follows SB3: ``seed(s)`` gives copy i the seed s + i at the next ``reset()``; a copy
     reset after its episode ends continues its own random stream (as ``gym.Env.reset()``).
 
-    The copies share one task object, so ``get_attr``/``set_attr``/``env_method`` act on the
+    The copies share one scene object, so ``get_attr``/``set_attr``/``env_method`` act on the
     wrapped vector env (a read returns its value once per requested index); ``env_is_wrapped``
     is False for every copy (there are no per-copy wrappers).
 

@@ -14,7 +14,7 @@ plays as any rl-zoo3 entry (HybridPPO wraps the env's hybrid Tuple action space 
 
 rl-zoo3 (2.9) builds its evaluation env (``--eval-freq``, every 25,000 steps by default) with
 the env arguments of the command line only, not those of the hyperparameter file: with
-``-conf`` alone it evaluates on the env's defaults (the diff drive's "time" task for an
+``-conf`` alone it evaluates on the env's defaults (the diff drive's "time" objective for an
 "effort" entry; for HybridPPO the Box action space, which fails at the first evaluation). The
 launcher's ``train`` therefore adds ``--eval-env-kwargs`` with the entry's ``env_kwargs`` when
 the command gives none (``eval_env_arguments``). Every other algorithm needs no launcher:

@@ -129,16 +129,16 @@ QUICK = EnvsConfig(
 
 
 def frame_skip(env: Any) -> int:
-    """Physics steps per env step: ``task.frame_skip`` for ours, ``frame_skip`` (MuJoCo) else 1.
+    """Physics steps per env step: ``scene.frame_skip`` for ours, ``frame_skip`` (MuJoCo) else 1.
 
     Works on a single env, a vector env and a ``SyncVectorEnv`` (its first sub-env).
     """
     if hasattr(env, "envs"):
         env = env.envs[0]
     inner = env.unwrapped
-    task = getattr(inner, "task", None)
-    if task is not None and hasattr(task, "frame_skip"):
-        return int(task.frame_skip)
+    scene = getattr(inner, "scene", None)
+    if scene is not None and hasattr(scene, "frame_skip"):
+        return int(scene.frame_skip)
     return int(getattr(inner, "frame_skip", 1))
 
 

@@ -88,7 +88,7 @@ def _build_parser() -> argparse.ArgumentParser:
     simulate.add_argument("--save", type=Path, default=None, help="write a .gif or .mp4")
     simulate.add_argument("--human", action="store_true", help="show a window while playing")
     simulate.add_argument("--env-arg", action="append", default=[], metavar="KEY=VALUE",
-                          help="environment argument, e.g. task=effort (repeatable)")
+                          help="environment argument, e.g. objective=effort (repeatable)")
     simulate.set_defaults(handler=_run_simulate)
 
     compile_ = commands.add_parser(

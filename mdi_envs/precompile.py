@@ -19,7 +19,7 @@ from typing import Any
 VARIANTS: dict[str, tuple[dict[str, Any], ...]] = {
     "mdi_envs/BlockableManipulator-v0": ({}, {"action_mode": "hybrid"},
                                          {"action_mode": "brake_force"}),
-    "mdi_envs/DiffDriveRobot-v0": ({"task": "time"}, {"task": "effort"}),
+    "mdi_envs/DiffDriveRobot-v0": ({"objective": "time"}, {"objective": "effort"}),
 }
 """Keyword arguments of the variants a registered id documents (default: the plain id)."""
 

@@ -149,7 +149,7 @@ def _diff_drive(cost: str, num_intervals: int = 100) -> OptimalControlProblem:
         impulse_scale=weight_impulse,
         velocity_scale=1.0,
         env_id=DIFF_DRIVE_ENV_ID,
-        env_kwargs=(("task", "effort" if effort else "time"),),
+        env_kwargs=(("objective", "effort" if effort else "time"),),
         description=(
             "differential drive, maneuver A: (0, 0, 0) -> (2, 5, -pi/2) at rest, "
             f"effort-optimal at t_f = {maneuver.effort_final_time} s" if effort else

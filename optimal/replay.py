@@ -120,7 +120,7 @@ def env_options(reference: Reference) -> dict[str, Any]:
     """``gym.make`` keyword arguments under which one env step is one reference interval.
 
     time_step = h, frame_skip = 1, no start noise, the reference's torque bound, an episode
-    limit of N steps, plus the metadata's ``env_kwargs`` (e.g. ``task="effort"``).
+    limit of N steps, plus the metadata's ``env_kwargs`` (e.g. ``objective="effort"``).
     """
     meta = reference.metadata
     has_brake = reference.brake_bound is not None and reference.brake_bound.shape[1]

@@ -115,7 +115,7 @@ class OptimalControlProblem:
         time_scale: [s] unit of t_f (and of the time-optimal cost).
         env_id: the environment the reference is meant for (metadata).
         env_kwargs: (key, value) pairs for ``gym.make(env_id, ...)`` (metadata), e.g. the
-            robot's ``task="effort"``.
+            robot's ``objective="effort"``.
         description: one line for humans.
         goal_q_tolerance: |q_i(t_f) - goal| <= this for the ``goal_q`` entries [rad or m]; 0
             imposes the goal exactly (every reference; the MPC's fallback relaxes it).

@@ -79,7 +79,7 @@ def test_simulate_open_loop_file_and_env_args(
     actions = tmp_path / "actions.csv"
     np.savetxt(actions, np.tile([0.5, 0.5], (10, 1)), delimiter=",")
     assert main(["simulate", "mdi_envs/DiffDriveRobot-v0", "--policy", str(actions),
-                 "--env-arg", "task=effort", "--steps", "10"]) == 0
+                 "--env-arg", "objective=effort", "--steps", "10"]) == 0
     out = capsys.readouterr().out
     assert "10 steps (stopped)" in out and "elapsed 0.500 s" in out
     with pytest.raises(ValueError, match=".npy or .csv"):

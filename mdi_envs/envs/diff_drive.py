@@ -38,16 +38,14 @@ class DiffDriveRobotScene(MoreauJeanScene):
     def __init__(
         self,
         *,
-        task: str = "time",
+        objective: str = "time",
         max_wheel_torque: float = DIFF_DRIVE_MANEUVER.max_wheel_torque,
         time_step: float = 0.01,
         frame_skip: int = 5,
         reset_noise_scale: float = 0.01,
         **options: Any,
     ) -> None:
-        if task not in self.OBJECTIVE_OPTIONS:
-            raise ValueError(f"task must be one of {self.OBJECTIVE_OPTIONS}, got {task!r}")
-        super().__init__(time_step=time_step, frame_skip=frame_skip, objective=task,
+        super().__init__(time_step=time_step, frame_skip=frame_skip, objective=objective,
                          final_time=DIFF_DRIVE_MANEUVER.effort_final_time,
                          reset_noise_scale=reset_noise_scale, **options)  # fmt: skip
         self.max_wheel_torque = require_positive("max_wheel_torque", max_wheel_torque)
@@ -127,8 +125,8 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     paper's 2-DOF (both wheels roll), 3-DOF (one slips) and 5-DOF (both slip) modes. The maneuver
     (Yunt & Glocker 2007, section 3.2): from rest at the origin, heading +x, to
     (x, y, phi) = (2 m, 5 m, -pi/2) at rest, wheel angles free.
-    `task="time"` is maneuver B (time-optimal; paper 4.03 s); `task="effort"` is maneuver A
-    (minimise the integral of tau_L^2 + tau_R^2 with the final time fixed at 4.05 s).
+    `objective="time"` is maneuver B (time-optimal; paper 4.03 s); `objective="effort"` is
+    maneuver A (minimise the integral of tau_L^2 + tau_R^2 with the final time fixed at 4.05 s).
 
     ## Action Space
     `Box(-1, 1, (2,), float32)`: normalised wheel torques (tau_L, tau_R) / max_wheel_torque.
@@ -177,7 +175,7 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     ## Arguments
     | parameter         | type  | default | description                                      |
     |-------------------|-------|---------|--------------------------------------------------|
-    | task              | str   | "time"  | "time" (maneuver B) or "effort" (maneuver A)     |
+    | objective         | str   | "time"  | "time" (maneuver B) or "effort" (maneuver A)     |
     | max_wheel_torque  | float | 3.0     | wheel torque bound [N m] (``mdi_envs.maneuvers``) |
     | time_step         | float | 0.01    | physics step [s]                                 |
     | frame_skip        | int   | 5       | physics steps per env step                       |
@@ -189,8 +187,8 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     | reset_noise_scale | float | 0.01    | start-state noise half-width                     |
     | render_mode       | str   | None    | "rgb_array" or "human"                           |
 
-    `gym.make("mdi_envs/DiffDriveRobot-v0", task="effort")`;
-    `gym.make_vec("mdi_envs/DiffDriveRobot-v0", num_envs=256, task="time")`.
+    `gym.make("mdi_envs/DiffDriveRobot-v0", objective="effort")`;
+    `gym.make_vec("mdi_envs/DiffDriveRobot-v0", num_envs=256, objective="time")`.
 
     ## Version History
     * v0: initial release.

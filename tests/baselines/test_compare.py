@@ -171,10 +171,10 @@ def test_unknown_task_is_rejected() -> None:
 
 
 def test_shipped_policies_match_env_and_task(tmp_path: Path) -> None:
-    config = {"env_id": DIFF_DRIVE, "task": "effort", "algo": "PPO"}
+    config = {"env_id": DIFF_DRIVE, "objective": "effort", "algo": "PPO"}
     (tmp_path / "a.json").write_text(json.dumps(config))
     (tmp_path / "a.zip").write_bytes(b"")
-    (tmp_path / "b.json").write_text(json.dumps({**config, "task": "time"}))
+    (tmp_path / "b.json").write_text(json.dumps({**config, "objective": "time"}))
     (tmp_path / "b.zip").write_bytes(b"")
     (tmp_path / "c.json").write_text(json.dumps(config))  # no zip beside it
     assert shipped_policies(DIFF_DRIVE, "effort", tmp_path) == [tmp_path / "a.json"]
@@ -188,15 +188,15 @@ def test_compare_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert f"| BlockableManipulator-v0 | time | {OPTIMAL} | " in table
     assert (tmp_path / "compare.md").read_text().strip() == table.strip()
     assert (tmp_path / "compare_BlockableManipulator-v0_time.png").exists()
-    with pytest.raises(SystemExit, match="has no task"):
-        main(["compare", MANIPULATOR, "--task", "effort", "--output", str(tmp_path)])
+    with pytest.raises(SystemExit, match="has no objective"):
+        main(["compare", MANIPULATOR, "--objective", "effort", "--output", str(tmp_path)])
 
 
 def test_a_row_rerun_merges_into_the_comparison(tmp_path: Path) -> None:
     from mdi_envs.cli import main
 
-    common = ["compare", DIFF_DRIVE, "--task", "effort", "--seeds", "1", "--trained", str(tmp_path),
-              "--output", str(tmp_path)]  # fmt: skip
+    common = ["compare", DIFF_DRIVE, "--objective", "effort", "--seeds", "1", "--trained",
+              str(tmp_path), "--output", str(tmp_path)]  # fmt: skip
     assert main(common) == 0
     path = tmp_path / "compare_DiffDriveRobot-v0_effort.json"
     first = json.loads(path.read_text())

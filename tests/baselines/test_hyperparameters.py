@@ -22,8 +22,8 @@ HYPERPARAMETERS = hyperparameter_table()
 
 def test_table_covers_both_envs_tasks_and_algorithms() -> None:
     assert len(HYPERPARAMETERS) == 13 and set(ALGORITHM_CLASSES) == set(ALGORITHMS)
-    for (env_id, task, algo), entry in HYPERPARAMETERS.items():
-        assert env_id in gym.registry and algo in ALGORITHMS and task in ("time", "effort")
+    for (env_id, objective, algo), entry in HYPERPARAMETERS.items():
+        assert env_id in gym.registry and algo in ALGORITHMS and objective in ("time", "effort")
         assert {"num_envs", "total_timesteps", "seed", "algo_kwargs", "env_kwargs",
                 "normalize_reward"} <= set(entry)
         assert isinstance(entry["normalize_reward"], bool)
@@ -36,7 +36,7 @@ def test_every_entry_fixes_the_shaping_discount_and_lookups_copy() -> None:
         expected = 0.99 if key == ("mdi_envs/BlockableManipulator-v0", "time", "PPO") else 1.0
         assert entry["env_kwargs"]["shaping_discount"] == expected, key
     entry = get_hyperparameters("mdi_envs/DiffDriveRobot-v0", "sac", "effort")
-    assert entry["env_kwargs"] == {"task": "effort", "goal_weight": 1000.0,
+    assert entry["env_kwargs"] == {"objective": "effort", "goal_weight": 1000.0,
                                    "shaping_discount": 1.0}  # fmt: skip
     entry["algo_kwargs"]["gamma"] = 0.5
     entry["env_kwargs"]["goal_weight"] = 1.0
@@ -59,7 +59,7 @@ def test_hybrid_ppo_uses_the_ppo_settings_on_the_hybrid_space() -> None:
 
 
 def test_one_file_per_algorithm_and_task() -> None:
-    files = {hyperparameter_file(algo, task) for _, task, algo in HYPERPARAMETERS}
+    files = {hyperparameter_file(algo, objective) for _, objective, algo in HYPERPARAMETERS}
     assert files == set(HYPERPARAMS_DIR.glob("*.yml"))
     assert hyperparameter_file("ppo", "effort").name == "ppo_effort.yml"
     assert hyperparameter_file("HybridPPO").name == "hybridppo.yml"
@@ -67,9 +67,9 @@ def test_one_file_per_algorithm_and_task() -> None:
 
 def test_entry_from_zoo_maps_rl_zoo3_keys_and_rejects_the_unsupported() -> None:
     zoo = {"n_envs": 8, "n_timesteps": 1e5, "policy": "MlpPolicy", "gamma": 0.9,
-           "normalize": {"norm_obs": False, "norm_reward": True}, "env_kwargs": {"task": "x"}}
+           "normalize": {"norm_obs": False, "norm_reward": True}, "env_kwargs": {"objective": "x"}}
     assert entry_from_zoo(zoo) == {"num_envs": 8, "total_timesteps": 100_000, "seed": 0,
-                                   "algo_kwargs": {"gamma": 0.9}, "env_kwargs": {"task": "x"},
+                                   "algo_kwargs": {"gamma": 0.9}, "env_kwargs": {"objective": "x"},
                                    "normalize_reward": True}  # fmt: skip
     with pytest.raises(ValueError, match="MlpPolicy"):
         entry_from_zoo({**zoo, "policy": "CnnPolicy"})
@@ -91,7 +91,7 @@ def test_shipped_policies_were_trained_with_the_table() -> None:
     assert configs, "no shipped policy"
     for path in configs:
         config = json.loads(path.read_text())
-        entry = get_hyperparameters(config["env_id"], config["algo"], config["task"])
+        entry = get_hyperparameters(config["env_id"], config["algo"], config["objective"])
         assert config["total_timesteps"] == entry["total_timesteps"], path.name
         assert config["num_envs"] == entry["num_envs"], path.name
         assert config["algo_kwargs"] == entry["algo_kwargs"], path.name
@@ -102,11 +102,12 @@ def test_shipped_policies_were_trained_with_the_table() -> None:
 @pytest.mark.parametrize("algo", ["TQC", "CrossQ"])
 def test_the_off_policy_algorithms_share_sacs_settings(algo: str) -> None:
     """TQC and CrossQ: SAC's copies, budget, replay ratio, n-step returns and rewards."""
-    tasks = [(env_id, task) for env_id, task, name in HYPERPARAMETERS if name == algo]
-    assert len(tasks) == 3  # the manipulator and both diff-drive tasks
-    for env_id, task in tasks:
-        entry = get_hyperparameters(env_id, algo, task)
-        sac = get_hyperparameters(env_id, "SAC", task)
+    objectives = [(env_id, objective) for env_id, objective, name in HYPERPARAMETERS
+                  if name == algo]
+    assert len(objectives) == 3  # the manipulator and both diff-drive objectives
+    for env_id, objective in objectives:
+        entry = get_hyperparameters(env_id, algo, objective)
+        sac = get_hyperparameters(env_id, "SAC", objective)
         shared = ("train_freq", "gradient_steps", "learning_starts", "batch_size", "n_steps",
                   "gamma", "buffer_size", "ent_coef")
         assert (entry["num_envs"], entry["total_timesteps"]) == (sac["num_envs"],
@@ -115,7 +116,7 @@ def test_the_off_policy_algorithms_share_sacs_settings(algo: str) -> None:
                                                                  for key in shared]
         assert sac["algo_kwargs"]["n_steps"] == 10
         assert entry["env_kwargs"] == sac["env_kwargs"]
-        assert entry["normalize_reward"] == sac["normalize_reward"] == (task == "effort")
-        if task == "effort":  # PPO's effort reward
-            ppo = get_hyperparameters(env_id, "PPO", task)
+        assert entry["normalize_reward"] == sac["normalize_reward"] == (objective == "effort")
+        if objective == "effort":  # PPO's effort reward
+            ppo = get_hyperparameters(env_id, "PPO", objective)
             assert entry["env_kwargs"] == ppo["env_kwargs"]

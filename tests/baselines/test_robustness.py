@@ -48,16 +48,16 @@ def test_open_loop_reference_is_played_under_every_condition(tmp_path: Path) -> 
 
 def test_cli_writes_json_plot_and_table(tmp_path: Path) -> None:
     out = tmp_path / "out"
-    assert main([ROBOT, "--task", "effort", "--seeds", "1", "--scales", "0.01",
+    assert main([ROBOT, "--objective", "effort", "--seeds", "1", "--scales", "0.01",
                  "--trained", str(tmp_path), "--output", str(out)]) == 0
     study = json.loads((out / "robustness_DiffDriveRobot-v0_effort.json").read_text())
-    assert study["task"] == "effort" and study["seeds"] == 1
+    assert study["objective"] == "effort" and study["seeds"] == 1
     assert (out / "robustness_DiffDriveRobot-v0_effort.png").stat().st_size > 0
     assert "| optimal (open loop) | 1 |" in (out / "robustness.md").read_text()
     # one line per episode: the open loop under 0.01 and the four mismatches
     assert len((out / "episodes.jsonl").read_text().splitlines()) == 5
-    # a rerun of another env x task keeps this one's rows in robustness.md
-    assert main([ROBOT, "--task", "time", "--seeds", "1", "--scales", "0.01", "--no-mismatch",
+    # a rerun of another env x objective keeps this one's rows in robustness.md
+    assert main([ROBOT, "--objective", "time", "--seeds", "1", "--scales", "0.01", "--no-mismatch",
                  "--trained", str(tmp_path), "--output", str(out)]) == 0
     table = (out / "robustness.md").read_text()
     assert "DiffDriveRobot-v0 effort" in table and "DiffDriveRobot-v0 time" in table
@@ -65,7 +65,7 @@ def test_cli_writes_json_plot_and_table(tmp_path: Path) -> None:
 
 def test_a_controller_rerun_merges_into_the_study(tmp_path: Path) -> None:
     out = tmp_path / "out"
-    common = [ROBOT, "--task", "effort", "--seeds", "1", "--no-mismatch", "--trained",
+    common = [ROBOT, "--objective", "effort", "--seeds", "1", "--no-mismatch", "--trained",
               str(tmp_path), "--output", str(out)]
     assert main([*common, "--scales", "0.01"]) == 0
     assert main([*common, "--scales", "0.3", "--controllers", "optimal (open loop)"]) == 0
@@ -76,7 +76,7 @@ def test_a_controller_rerun_merges_into_the_study(tmp_path: Path) -> None:
     assert [r["condition"] for r in row["results"]] == ["perturbation 0.01", "perturbation 0.3"]
     assert row["results"][1]["success_rate"] == 0.0  # the open loop at 0.3 (as above)
     # one mismatch alone, no perturbation scale: merged after the scales
-    assert main([ROBOT, "--task", "effort", "--seeds", "1", "--trained", str(tmp_path),
+    assert main([ROBOT, "--objective", "effort", "--seeds", "1", "--trained", str(tmp_path),
                  "--output", str(out), "--scales", "--mismatches", "friction +20 %",
                  "--controllers", "optimal (open loop)"]) == 0
     study = json.loads((out / "robustness_DiffDriveRobot-v0_effort.json").read_text())

@@ -107,7 +107,7 @@ def test_cli_rejects_unknown_combinations() -> None:
     with pytest.raises(SystemExit):
         parser.parse_args(["train", "mdi_envs/BouncingBall-v0", "PPO"])
     args = parser.parse_args(["train", MANIPULATOR, "ppo"])
-    assert args.algo == "PPO" and args.task is None and args.seed is None
+    assert args.algo == "PPO" and args.objective is None and args.seed is None
 
 
 def test_plot_training_handles_empty_and_full_logs(tmp_path: Path) -> None:

@@ -18,9 +18,9 @@ DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
 # (env id, env kwargs): short truncation, a fixed-horizon termination, and both at once
 CASES = [
     (MANIPULATOR, {"max_episode_steps": 37}),
-    (DIFF_DRIVE, {"task": "effort"}),
-    (DIFF_DRIVE, {"task": "effort", "max_episode_steps": 81}),
-    (DIFF_DRIVE, {"task": "time", "max_episode_steps": 23}),
+    (DIFF_DRIVE, {"objective": "effort"}),
+    (DIFF_DRIVE, {"objective": "effort", "max_episode_steps": 81}),
+    (DIFF_DRIVE, {"objective": "time", "max_episode_steps": 23}),
 ]
 NUM_ENVS = 4
 
@@ -105,7 +105,7 @@ def test_sb3_contract(env_id: str, kwargs: dict[str, Any]) -> None:
 
 
 def test_vec_monitor_reports_episodes() -> None:
-    venv = VecMonitor(make_vec_env(DIFF_DRIVE, NUM_ENVS, task="effort"))
+    venv = VecMonitor(make_vec_env(DIFF_DRIVE, NUM_ENVS, objective="effort"))
     venv.seed(0)
     venv.reset()
     rng = np.random.default_rng(2)

@@ -28,10 +28,10 @@ def test_rl_zoo3_resolves_our_entry(key: tuple[str, str, str]) -> None:
     """rl-zoo3's own reader finds the env id's entry (not its "default") with our values."""
     from rl_zoo3.exp_manager import ExperimentManager
 
-    env_id, task, algo = key
-    entry = get_hyperparameters(env_id, algo, task)
+    env_id, objective, algo = key
+    entry = get_hyperparameters(env_id, algo, objective)
     manager = ExperimentManager(argparse.Namespace(), ZOO_ALGOS[algo], env_id, "unused",
-                                config=str(hyperparameter_file(algo, task)))  # fmt: skip
+                                config=str(hyperparameter_file(algo, objective)))  # fmt: skip
     hyperparams, _ = manager.read_hyperparameters()
     model_kwargs, *_ = manager._preprocess_hyperparams(dict(hyperparams))
     assert manager.n_envs == entry["num_envs"]
@@ -92,9 +92,9 @@ def test_the_launcher_gives_rl_zoo3_the_entry_env_kwargs_for_evaluation() -> Non
     conf = str(hyperparameter_file("PPO", "effort"))
     args = ["--algo", "ppo", "--env", "mdi_envs/DiffDriveRobot-v0", "-conf", conf]
     extra = eval_env_arguments(args)
-    assert extra == ["--eval-env-kwargs", "task:'effort'", "goal_weight:1000.0",
+    assert extra == ["--eval-env-kwargs", "objective:'effort'", "goal_weight:1000.0",
                      "shaping_discount:1.0"]  # fmt: skip
     assert {k: eval(v) for k, v in (a.split(":", 1) for a in extra[1:])} == get_hyperparameters(
         "mdi_envs/DiffDriveRobot-v0", "PPO", "effort")["env_kwargs"]  # rl-zoo3 evals each value
-    assert eval_env_arguments([*args, "--eval-env-kwargs", "task:'time'"]) == []
+    assert eval_env_arguments([*args, "--eval-env-kwargs", "objective:'time'"]) == []
     assert eval_env_arguments(["--env", "mdi_envs/DiffDriveRobot-v0"]) == []

@@ -1,4 +1,4 @@
-"""DiffDriveRobot-v0: rolling and slipping modes through the env, and the two tasks."""
+"""DiffDriveRobot-v0: rolling and slipping modes through the env, and the two objectives."""
 
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ def test_full_opposite_torques_spin_and_slip() -> None:
 
 
 def test_effort_task_ends_at_the_fixed_horizon() -> None:
-    env = make(task="effort")
+    env = make(objective="effort")
     env.reset(seed=0)
     num_steps = round(DIFF_DRIVE_MANEUVER.effort_final_time / env.unwrapped.dt)
     for k in range(num_steps):
@@ -58,6 +58,6 @@ def test_effort_task_ends_at_the_fixed_horizon() -> None:
 
 def test_effort_horizon_must_be_a_whole_number_of_steps() -> None:
     with pytest.raises(ValueError, match="whole number"):
-        make(task="effort", time_step=0.01, frame_skip=7)
-    with pytest.raises(ValueError, match="task"):
-        make(task="distance")
+        make(objective="effort", time_step=0.01, frame_skip=7)
+    with pytest.raises(ValueError, match="objective"):
+        make(objective="distance")
