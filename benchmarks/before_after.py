@@ -37,16 +37,9 @@ LIMIT = 1.10
 
 
 def _targets(record: dict[str, Any]) -> dict[str, tuple[float, str]]:
-    """{target: (measured, unit)} of a benchmark record (both of the suite's spellings)."""
-    found = {}
-    for target in record.get("targets") or []:
-        if target.get("measured_us", target.get("measured")) is None:
-            continue  # not measured in this run
-        if "measured_us" in target:
-            found[target["target"]] = (float(target["measured_us"]), "µs")
-        elif isinstance(target.get("measured"), (int, float)):
-            found[target["target"]] = (float(target["measured"]), target.get("unit", ""))
-    return found
+    """{target: (measured, unit)} of a benchmark record's measured targets."""
+    return {t["target"]: (float(t["measured"]), t["unit"]) for t in record.get("targets") or []
+            if isinstance(t.get("measured"), (int, float))}
 
 
 def _lower_is_better(unit: str) -> bool:

@@ -28,7 +28,8 @@ BENCHMARKS = {
     "precision": ("benchmarks.work_precision", "error vs wall time per scene vs closed form, "
                   "the event-driven reference and MuJoCo"),
     "fc3d": ("benchmarks.fc3d", "every FC3D method on the 35 Siconos fc3d peer problems"),
-    "stress": ("benchmarks.stress", "numerical stress cases with pass/fail criteria"),
+    "stress": ("benchmarks.stress", "numerical stress cases with pass/fail criteria (the "
+               "pytest cases of tests/stress)"),
     "startup": ("benchmarks.startup", "interpreter start to the first env step, warm and "
                 "cold kernel cache, vs Acrobot-v1 and MuJoCo; mdi-envs compile all"),
 }

@@ -259,11 +259,11 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
         rows.append({"model": model, "scene": scene, "entry": entry,
                      **value.summary(operations_per_call=steps)})
     for case in cases:
-        cells = [f"{r['scene']} {R.format_us_fine(r['median_s'])}" for r in rows
+        cells = [f"{r['scene']} {report.format_us_fine(r['median_s'])}" for r in rows
                  if r["model"] == case.label and r["entry"] == "step"]
         log(f"  {case.label} step() µs: " + ", ".join(cells))
     if arm is not None:
-        cells = [f"{r['scene']} {R.format_us_fine(r['median_s'])}" for r in rows
+        cells = [f"{r['scene']} {report.format_us_fine(r['median_s'])}" for r in rows
                  if r["model"] == "mujoco"]
         log("  MuJoCo mj_step µs: " + ", ".join(cells))
     return rows
@@ -331,7 +331,7 @@ def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
         model, scene = key.split("|")
         rows.append({"model": model, "scene": scene,
                      **_per_copy_step(value.summary(), n, substeps[key])})
-    log("  " + ", ".join(f"{r['model']}/{r['scene']} {R.format_us_fine(r['per_copy_step_s'])}"
+    log("  " + ", ".join(f"{r['model']}/{r['scene']} {report.format_us_fine(r['per_copy_step_s'])}"
                          for r in rows))
     return rows
 
@@ -354,7 +354,7 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
                     for key, value in timed.items()]
         rows += measured
         log(f"batched N = {n}: " + ", ".join(
-            f"{r['model']} {R.format_us_fine(r['per_copy_step_s'])} µs (x{r['substeps']})"
+            f"{r['model']} {report.format_us_fine(r['per_copy_step_s'])} µs (x{r['substeps']})"
             for r in measured) + f"; load {_load_text()}")
     return rows
 
@@ -379,7 +379,8 @@ def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
     for (model, substeps), _ in calls.items():
         rows.append({"model": model,
                      **_per_copy_step(timed[f"{model}|{substeps}"].summary(), n, substeps)})
-    log("  " + ", ".join(f"{r['model']} x{r['substeps']} {R.format_us_fine(r['per_copy_step_s'])}"
+    log("  " + ", ".join(f"{r['model']} x{r['substeps']} "
+                         f"{report.format_us_fine(r['per_copy_step_s'])}"
                          for r in rows))
     return rows
 
@@ -441,8 +442,8 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
                                          / row["on"]["per_copy_step_min_s"])
         rows.append(row)
         log(f"shortcut {sc.shortcut} on {sc.model}/{sc.scene}: on "
-            f"{R.format_us_fine(row['on']['per_copy_step_s'])} µs, off "
-            f"{R.format_us_fine(row['off']['per_copy_step_s'])} µs"
+            f"{report.format_us_fine(row['on']['per_copy_step_s'])} µs, off "
+            f"{report.format_us_fine(row['off']['per_copy_step_s'])} µs"
             f"{'' if off_scene == sc.scene else f' ({off_scene})'}, speedup "
             f"{row['speedup']:.2f}")
     return rows
@@ -491,23 +492,21 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
         return (largest["per_copy_step_s"], largest["copies"],
                 min(r["per_copy_step_s"] for r in rows))
 
+    def us(seconds: float | None) -> float | None:
+        return None if seconds is None else seconds * 1e6
+
     targets = []
-    value, copies, best = batched_at_largest("manipulator")
-    targets.append(R.target_row("manipulator, batched, µs per copy-step (mix, largest N)",
-                                TARGETS_US["manipulator_batched"], value,
-                                f"N = {copies}; best over N {R.format_us_fine(best)} µs"
-                                if best is not None else ""))
-    targets.append(R.target_row(
-        "manipulator, one InPlaceStepper.step() from Python (slowest scene)",
-        TARGETS_US["manipulator_python"], python_worst("manipulator")))
-    value, copies, best = batched_at_largest("diff_drive")
-    targets.append(R.target_row("diff-drive, batched, µs per copy-step (mix, largest N)",
-                                TARGETS_US["diff_drive"], value,
-                                f"N = {copies}; best over N {R.format_us_fine(best)} µs"
-                                if best is not None else ""))
-    targets.append(R.target_row(
-        "diff-drive, one InPlaceStepper.step() from Python (slowest scene)",
-        TARGETS_US["diff_drive"], python_worst("diff_drive")))
+    for model, title in (("manipulator", "manipulator"), ("diff_drive", "diff-drive")):
+        value, copies, best = batched_at_largest(model)
+        key = "manipulator_batched" if model == "manipulator" else model
+        targets.append(report.target_row(
+            f"{title}, batched, µs per copy-step (mix, largest N)", "≤", TARGETS_US[key], "µs",
+            us(value), f"N = {copies}; best over N {report.format_us_fine(best)} µs"
+            if best is not None else ""))
+        key = "manipulator_python" if model == "manipulator" else model
+        targets.append(report.target_row(
+            f"{title}, one InPlaceStepper.step() from Python (slowest scene)", "≤",
+            TARGETS_US[key], "µs", us(python_worst(model))))
     return targets
 
 

@@ -9,11 +9,12 @@ from typing import Any
 import numpy as np
 
 from benchmarks.report import (
-    format_us,
-    load_average_text,
-    machine_speed_text,
+    format_us_fine,
     markdown_table,
     plt,
+    run_line,
+    save_figure,
+    targets_table,
 )
 
 MODEL_TITLES = {
@@ -30,14 +31,6 @@ SHORTCUT_TITLES = {
     "direct_solve_max_size": "direct_solve_max_size 3 vs 0",
     "no_solve": "no closed contact / brake → no solve (no switch: free vs active step)",
 }
-
-
-def format_us_fine(seconds: float | None) -> str:
-    """Seconds as µs, with three significant digits below 1 µs (``"0.0512"``)."""
-    if seconds is None or not np.isfinite(seconds):
-        return "–"
-    us = seconds * 1e6
-    return f"{us:.3g}" if us < 1.0 else format_us(seconds)
 
 
 def shortcuts_text(shortcuts: Any) -> str:
@@ -61,52 +54,19 @@ def case_record(case: Any) -> dict[str, Any]:
     }
 
 
-def target_row(name: str, threshold_us: float, value_s: float | None, note: str = ""
-               ) -> dict[str, Any]:
-    """One target check: met is None when nothing was measured."""
-    return {
-        "target": name,
-        "threshold_us": threshold_us,
-        "measured_us": None if value_s is None else value_s * 1e6,
-        "met": None if value_s is None else bool(value_s * 1e6 <= threshold_us),
-        "note": note,
-    }
-
-
-def _mark(met: bool | None) -> str:
-    return "not measured" if met is None else ("✓" if met else "✗")
-
-
-def targets_table(targets: Sequence[dict[str, Any]]) -> str:
-    """Markdown: target, threshold, measured, ✓/✗, note."""
-    rows = [
-        [t["target"], f"≤ {t['threshold_us']:g} µs",
-         "–" if t["measured_us"] is None else format_us_fine(t["measured_us"] * 1e-6) + " µs",
-         _mark(t["met"]), t["note"]]
-        for t in targets
-    ]
-    return markdown_table(["target", "threshold", "measured", "met", "note"], rows)
-
-
 def compile_table(records: Sequence[dict[str, Any]]) -> str:
     """Markdown: stepper, first step() [s], first step_batch() [s]."""
-    rows = [
-        [r["stepper"], "–" if r["step_s"] is None else f"{r['step_s']:.1f}",
-         f"{r['step_batch_s']:.1f}"]
-        for r in records
-    ]
-    header = ["stepper", "first step() s", "first step_batch() s (after step)"]
-    return markdown_table(header, rows)
+    return markdown_table([{
+        "stepper": r["stepper"],
+        "first step() s": "–" if r["step_s"] is None else f"{r['step_s']:.1f}",
+        "first step_batch() s (after step)": f"{r['step_batch_s']:.1f}"} for r in records])
 
 
 def scenes_table(models: Sequence[dict[str, Any]]) -> str:
     """Markdown: model, scene, in the batched mix?, description."""
-    rows = [
-        [m["label"], s["name"], "yes" if s["name"] in m["mix"] else "no", s["description"]]
-        for m in models
-        for s in m["scenes"]
-    ]
-    return markdown_table(["model", "scene", "in the batched mix", "what"], rows)
+    return markdown_table([{
+        "model": m["label"], "scene": s["name"], "in the batched mix": "yes" if s["name"] in
+        m["mix"] else "no", "what": s["description"]} for m in models for s in m["scenes"]])
 
 
 def single_step_table(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str, Any]]
@@ -115,22 +75,16 @@ def single_step_table(single: Sequence[dict[str, Any]], scenes: Sequence[dict[st
     index = {(r["model"], r["scene"], r["entry"]): r["median_s"] for r in single}
     kernel = {(r["model"], r["scene"]): r["per_copy_step_s"] for r in scenes}
     copies = scenes[0]["copies"] if scenes else "N"
-    keys = list(dict.fromkeys((r["model"], r["scene"]) for r in single))
-    rows = []
-    for model, scene in keys:
-        if model == "mujoco":
-            python = index.get((model, scene, "mj_step"))
-            in_place = None
-        else:
-            python = index.get((model, scene, "step"))
-            in_place = index.get((model, scene, "in_place"))
-        title = "MuJoCo arm" if model == "mujoco" else MODEL_TITLES.get(model, model)
-        rows.append([title, scene, format_us_fine(python), format_us_fine(in_place),
-                     format_us_fine(kernel.get((model, scene)))])
-    header = ["model", "scene", "one step from Python µs (step() / MuJoCo mj_step)",
-              "InPlaceStepper.step() from Python µs",
-              f"in-kernel µs per step (batched, N = {copies})"]
-    return markdown_table(header, rows)
+    return markdown_table([{
+        "model": "MuJoCo arm" if model == "mujoco" else MODEL_TITLES.get(model, model),
+        "scene": scene,
+        "one step from Python µs (step() / MuJoCo mj_step)": format_us_fine(
+            index.get((model, scene, "mj_step" if model == "mujoco" else "step"))),
+        "InPlaceStepper.step() from Python µs": format_us_fine(
+            index.get((model, scene, "in_place"))),
+        f"in-kernel µs per step (batched, N = {copies})": format_us_fine(
+            kernel.get((model, scene)))}
+        for model, scene in dict.fromkeys((r["model"], r["scene"]) for r in single)])
 
 
 def batched_table(batched: Sequence[dict[str, Any]]) -> str:
@@ -138,16 +92,11 @@ def batched_table(batched: Sequence[dict[str, Any]]) -> str:
     models = list(dict.fromkeys(r["model"] for r in batched))
     sizes = sorted({r["copies"] for r in batched})
     index = {(r["model"], r["copies"]): r for r in batched}
-    rows = []
-    for n in sizes:
-        cells = []
-        for model in models:
-            r = index.get((model, n))
-            cells.append("–" if r is None else
-                         f"{format_us_fine(r['per_copy_step_s'])} (×{r['substeps']:,})")
-        rows.append([str(n), *cells])
-    header = ["N", *(MODEL_TITLES.get(m, m) for m in models)]
-    return markdown_table(header, rows)
+    def cell(r: dict[str, Any] | None) -> str:
+        return "–" if r is None else f"{format_us_fine(r['per_copy_step_s'])} (×{r['substeps']:,})"
+
+    return markdown_table([{"N": str(n), **{MODEL_TITLES.get(m, m): cell(index.get((m, n)))
+                                           for m in models}} for n in sizes])
 
 
 def substeps_table(substeps: Sequence[dict[str, Any]]) -> str:
@@ -157,27 +106,26 @@ def substeps_table(substeps: Sequence[dict[str, Any]]) -> str:
     index = {(r["model"], r["substeps"]): r["per_copy_step_s"] for r in substeps}
     rows = [[MODEL_TITLES.get(m, m), *(format_us_fine(index.get((m, k))) for k in grid)]
             for m in models]
-    return markdown_table(["model", *(f"{k} substeps/call" for k in grid)], rows)
+    return markdown_table(rows, ["model", *(f"{k} substeps/call" for k in grid)])
 
 
 def shortcuts_table(shortcuts: Sequence[dict[str, Any]]) -> str:
     """Markdown: shortcut, model/scene, on µs, off µs, speedup, largest state difference."""
-    rows = []
-    for r in shortcuts:
-        scene = r["scene"] if r["off_scene"] == r["scene"] else f"{r['scene']} vs {r['off_scene']}"
-        difference = r["max_state_difference"]
-        rows.append([
-            SHORTCUT_TITLES.get(r["shortcut"], r["shortcut"]),
-            f"{r['model']} / {scene}",
-            format_us_fine(r["on"]["per_copy_step_s"]),
-            format_us_fine(r["off"]["per_copy_step_s"]),
-            f"{r['speedup']:.2f}",
-            f"{r['speedup_fastest_rounds']:.2f}",
-            "–" if difference is None else f"{difference:.1e}",
-        ])
-    header = ["shortcut", "model / scene", "on µs", "off µs", "speedup off/on (medians)",
-              "speedup (fastest rounds)", "largest state difference on vs off"]
-    return markdown_table(header, rows)
+    return markdown_table([{
+        "shortcut": SHORTCUT_TITLES.get(r["shortcut"], r["shortcut"]),
+        "model / scene": f"{r['model']} / {_scene(r)}",
+        "on µs": format_us_fine(r["on"]["per_copy_step_s"]),
+        "off µs": format_us_fine(r["off"]["per_copy_step_s"]),
+        "speedup off/on (medians)": f"{r['speedup']:.2f}",
+        "speedup (fastest rounds)": f"{r['speedup_fastest_rounds']:.2f}",
+        "largest state difference on vs off": "–" if r["max_state_difference"] is None
+        else f"{r['max_state_difference']:.1e}"} for r in shortcuts])
+
+
+def _scene(row: Mapping[str, Any]) -> str:
+    """A shortcut row's scene, or both scenes where on and off ran different ones."""
+    same = row["off_scene"] == row["scene"]
+    return row["scene"] if same else f"{row['scene']} vs {row['off_scene']}"
 
 
 def brake_stop_table(brake: Mapping[str, Any]) -> str:
@@ -196,26 +144,16 @@ def brake_stop_table(brake: Mapping[str, Any]) -> str:
         elif "relative_speed_after_first_step" in value:
             speed = value["relative_speed_after_first_step"]
             setting = f"relative velocity after step 1: {speed:.1e} rad/s"
-        steps = value["steps"]
-        rows.append([titles.get(key, key), setting, "not reached" if steps is None else str(steps),
-                     f"{value['relative_angle_at_stop']:.2e}"])
-    header = ["simulator", "setting", "steps until relative velocity < 1 % of 1 rad/s",
-              "relative angle then (rad)"]
-    return markdown_table(header, rows)
+        rows.append({"simulator": titles.get(key, key), "setting": setting,
+                     "steps until relative velocity < 1 % of 1 rad/s": "not reached"
+                     if value["steps"] is None else str(value["steps"]),
+                     "relative angle then (rad)": f"{value['relative_angle_at_stop']:.2e}"})
+    return markdown_table(rows)
 
 
 def markdown_report(record: Mapping[str, Any]) -> str:
     """All result tables of one run, as printed on stdout and pasted into the README."""
-    machine = record["machine"]
-    versions = machine["versions"]
-    load_text = load_average_text(machine)
-    lines = [
-        f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
-        f"numpy {versions.get('numpy')}, numba {versions.get('numba')}, mujoco "
-        f"{versions.get('mujoco')}; total {record['run_time_s']:.0f} s"
-        f"{' (--quick)' if record['config']['quick'] else ''}; {load_text}; "
-        f"{machine_speed_text(machine)}.",
-    ]
+    lines = [run_line(record, ("numpy", "numba", "mujoco"))]
     if record["notes"]:
         lines += ["", *(f"* {note}" for note in record["notes"])]
     lines += ["", "**Targets**", "", targets_table(record["targets"])]
@@ -246,12 +184,6 @@ def markdown_report(record: Mapping[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def _save(fig: Any, path: Path) -> None:
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-
-
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],
                  targets_us: Mapping[str, float], path: Path) -> None:
     """µs per copy-step vs N (log-log), one line per model and MuJoCo, band = quartiles.
@@ -275,7 +207,7 @@ def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str,
     if substeps:
         _batched_panel(axes[1], substeps, "substeps", "substeps per call")
         axes[1].set_title(f"N = {substeps[0]['copies']}", fontsize=10)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def _batched_panel(ax: Any, rows_in: Sequence[dict[str, Any]], x_key: str, xlabel: str
@@ -328,7 +260,7 @@ def plot_single_step(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str
     ax.set_xlabel("µs per step")
     ax.grid(True, axis="x", which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, frameon=False)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
@@ -337,10 +269,8 @@ def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
     if shortcuts:
         labels = []
         for r in shortcuts:
-            scene = (r["scene"] if r["off_scene"] == r["scene"]
-                     else f"{r['scene']} vs {r['off_scene']}")
             name = "no solve (free vs active)" if r["shortcut"] == "no_solve" else r["shortcut"]
-            labels.append(f"{name}: {r['model']} / {scene}")
+            labels.append(f"{name}: {r['model']} / {_scene(r)}")
         y = np.arange(len(shortcuts))
         speedups = [r["speedup"] for r in shortcuts]
         colors = ["tab:gray" if r["shortcut"] == "no_solve" else "tab:blue" for r in shortcuts]
@@ -360,20 +290,16 @@ def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
     ax.set_xlabel("time off / time on (> 1: the shortcut saves time)\n"
                   "labels: on vs off, µs per copy-step (medians)")
     ax.grid(True, axis="x", which="both", alpha=0.3)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 __all__ = [
     "MODEL_TITLES",
     "brake_stop_table",
     "case_record",
-    "format_us_fine",
     "markdown_report",
     "plot_batched",
     "plot_shortcuts",
     "plot_single_step",
     "shortcuts_text",
-    "substeps_table",
-    "target_row",
-    "targets_table",
 ]

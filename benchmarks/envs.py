@@ -411,7 +411,7 @@ def evaluate_targets(single: Sequence[dict[str, Any]], vector: Sequence[dict[str
     by_id = {r["env_id"]: r for r in single}
     manipulator = by_id.get(MANIPULATOR)
     step = manipulator["gym.make"]["median_us"] if manipulator else None
-    targets = [R.target_row("manipulator env.step through gym.make (median)", "≤",
+    targets = [report.target_row("manipulator env.step through gym.make (median)", "≤",
                             TARGETS["manipulator_step_us"], "µs", step,
                             "" if step is None else
                             f"fastest rounds {manipulator['gym.make']['min_us']:.1f} µs, "
@@ -420,7 +420,7 @@ def evaluate_targets(single: Sequence[dict[str, Any]], vector: Sequence[dict[str
         if not record["ours"]:
             continue
         ratio = record["ratios"].get(ACROBOT)
-        targets.append(R.target_row(
+        targets.append(report.target_row(
             f"{R.short_name(record['env_id'])} env.step ≥ 3× faster than {ACROBOT} "
             "(Acrobot time / ours, medians)", "≥", TARGETS["speedup_vs_acrobot"], "×",
             None if ratio is None else ratio["ratio_median"],
@@ -436,7 +436,7 @@ def evaluate_targets(single: Sequence[dict[str, Any]], vector: Sequence[dict[str
         largest = max(rows, key=lambda r: r["num_envs"])
         note = (f"N = {wanted} not run (quick); at N = {largest['num_envs']}: "
                 f"{largest['physics_steps_per_s']:.3g}; " + note)
-    targets.append(R.target_row(
+    targets.append(report.target_row(
         f"manipulator vector env physics steps/s at num_envs = {wanted}, one core", "≥",
         TARGETS["manipulator_physics_steps_per_s"], "1/s",
         at[0]["physics_steps_per_s"] if at else None, note))

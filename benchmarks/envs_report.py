@@ -10,10 +10,11 @@ import numpy as np
 
 from benchmarks.report import (
     format_ratio,
-    load_average_text,
-    machine_speed_text,
     markdown_table,
     plt,
+    run_line,
+    save_figure,
+    targets_table,
 )
 
 SHORT_NAMES = {
@@ -30,64 +31,24 @@ def short_name(env_id: str) -> str:
     return name[:-3] if env_id.startswith("mdi_envs/") and name.endswith("-v0") else name
 
 
-def _number(value: float, unit: str) -> str:
-    if unit == "µs":
-        return f"{value:.1f} µs" if value < 100 else f"{value:,.0f} µs"
-    if unit == "×":
-        return f"{value:.2f}×"
-    return f"{value:.3g} {unit}"
-
-
-def target_row(name: str, comparison: str, threshold: float, unit: str, value: float | None,
-               note: str = "") -> dict[str, Any]:
-    """One target check (``comparison`` "≤" or "≥"); met is None when nothing was measured."""
-    met = None
-    if value is not None:
-        met = bool(value <= threshold) if comparison == "≤" else bool(value >= threshold)
-    return {"target": name, "comparison": comparison, "threshold": threshold, "unit": unit,
-            "measured": value, "met": met, "note": note}
-
-
-def targets_table(targets: Sequence[dict[str, Any]]) -> str:
-    """Markdown: target, threshold, measured, ✓/✗, note."""
-    rows = []
-    for t in targets:
-        mark = "not measured" if t["met"] is None else ("✓" if t["met"] else "✗")
-        measured = "–" if t["measured"] is None else _number(t["measured"], t["unit"])
-        rows.append([t["target"], f"{t['comparison']} {_number(t['threshold'], t['unit'])}",
-                     measured, mark, t["note"]])
-    return markdown_table(["target", "threshold", "measured", "met", "note"], rows)
-
-
 def single_table(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]]) -> str:
     """Markdown: per env the step times, frame_skip, µs per physics step and the ratios."""
     peers = [r["env_id"] for r in single if not r["ours"]]
-    rows = []
-    for r in single:
-        wrapped, bare = r["gym.make"], r["unwrapped"]
-        ratios = [
-            "–" if not r["ours"] or peer not in r.get("ratios", {})
-            else format_ratio(r["ratios"][peer]["ratio_median"])
-            for peer in peers
-        ]
-        rows.append([
-            f"{short_name(r['env_id'])}{'' if r['ours'] else ' (peer)'}",
-            f"{wrapped['median_us']:.1f} ({wrapped['q1_us']:.1f}–{wrapped['q3_us']:.1f})",
-            f"{wrapped['min_us']:.1f}",
-            f"{bare['median_us']:.1f}",
-            str(r["frame_skip"]),
-            f"{r['per_physics_step_us']:.1f}",
-            f"{r['first_make_s'] + r['first_reset_s'] + r['first_step_s']:.2f}",
-            *ratios,
-        ])
-    for item in unavailable:
-        rows.append([f"{short_name(item['env_id'])} (peer)",
-                     f"not measured: {item['error']}", "", "", "", "", "",
-                     *("" for _ in peers)])
     header = ["env", "env.step µs, gym.make (median, quartiles)", "fastest round µs",
               "unwrapped µs", "frame_skip", "µs per physics step (gym.make)",
               "first make+reset+step s", *(f"{short_name(p)} / ours" for p in peers)]
-    return markdown_table(header, rows)
+    rows = [[f"{short_name(r['env_id'])}{'' if r['ours'] else ' (peer)'}",
+             f"{r['gym.make']['median_us']:.1f} ({r['gym.make']['q1_us']:.1f}–"
+             f"{r['gym.make']['q3_us']:.1f})", f"{r['gym.make']['min_us']:.1f}",
+             f"{r['unwrapped']['median_us']:.1f}", str(r["frame_skip"]),
+             f"{r['per_physics_step_us']:.1f}",
+             f"{r['first_make_s'] + r['first_reset_s'] + r['first_step_s']:.2f}",
+             *("–" if not r["ours"] or peer not in r.get("ratios", {})
+               else format_ratio(r["ratios"][peer]["ratio_median"]) for peer in peers)]
+            for r in single]
+    rows += [[f"{short_name(item['env_id'])} (peer)", f"not measured: {item['error']}",
+              *("" for _ in header[2:])] for item in unavailable]
+    return markdown_table(rows, header)
 
 
 def vector_table(vector: Sequence[dict[str, Any]]) -> str:
@@ -95,35 +56,20 @@ def vector_table(vector: Sequence[dict[str, Any]]) -> str:
     columns = list(dict.fromkeys((r["env_id"], r["mode"]) for r in vector))
     sizes = sorted({r["num_envs"] for r in vector})
     index = {(r["env_id"], r["mode"], r["num_envs"]): r for r in vector}
-    rows = []
-    for n in sizes:
-        cells = []
-        for env_id, mode in columns:
-            r = index.get((env_id, mode, n))
-            cells.append("–" if r is None else
-                         f"{r['env_steps_per_s']:.3g} · {r['physics_steps_per_s']:.3g}")
-        rows.append([str(n), *cells])
-    header = ["num_envs", *(f"{short_name(e)} ({'sync' if m == 'sync' else 'vector'})"
-                            for e, m in columns)]
-    return markdown_table(header, rows)
+    def cell(r: dict[str, Any] | None) -> str:
+        return "–" if r is None else f"{r['env_steps_per_s']:.3g} · {r['physics_steps_per_s']:.3g}"
+
+    return markdown_table([{"num_envs": str(n), **{
+        f"{short_name(e)} ({'sync' if m == 'sync' else 'vector'})": cell(index.get((e, m, n)))
+        for e, m in columns}} for n in sizes])
 
 
 def markdown_report(record: Mapping[str, Any]) -> str:
     """All result tables of one run, as printed on stdout and pasted into the README."""
-    machine = record["machine"]
-    versions = machine["versions"]
-    load_text = load_average_text(machine)
     pinning = record["pinning"]
-    pin_text = (f"pinned to CPU {pinning['cpus']}" if pinning.get("pinned")
-                else f"not pinned (CPUs {pinning.get('cpus')})")
-    lines = [
-        f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs, "
-        f"{pin_text}), Python {machine['python']}, numpy {versions.get('numpy')}, numba "
-        f"{versions.get('numba')}, gymnasium {versions.get('gymnasium')}, mujoco "
-        f"{versions.get('mujoco')}; total {record['run_time_s']:.0f} s"
-        f"{' (--quick)' if record['config']['quick'] else ''}; {load_text}; "
-        f"{machine_speed_text(machine)}.",
-    ]
+    lines = [run_line(record, ("numpy", "numba", "gymnasium", "mujoco")) + " Python "
+             f"{record['machine']['python']}; " + (f"pinned to CPU {pinning['cpus']}."
+             if pinning.get("pinned") else f"not pinned (CPUs {pinning.get('cpus')}).")]
     if record["notes"]:
         lines += ["", *(f"* {note}" for note in record["notes"])]
     lines += ["", "**Targets**", "", targets_table(record["targets"])]
@@ -137,12 +83,6 @@ def markdown_report(record: Mapping[str, Any]) -> str:
                   "\"vector_entry_point\")`, Acrobot: `\"sync\"`; medians)", "",
                   vector_table(record["vector_env"])]
     return "\n".join(lines)
-
-
-def _save(fig: Any, path: Path) -> None:
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
 
 
 def plot_step(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]],
@@ -183,7 +123,7 @@ def plot_step(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, 
     ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, frameon=False,
               title="One environment: env.step time (lower is better)",
               title_fontproperties={"size": 10})
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def plot_vector(vector: Sequence[dict[str, Any]], targets: Mapping[str, float], path: Path
@@ -230,7 +170,7 @@ def plot_vector(vector: Sequence[dict[str, Any]], targets: Mapping[str, float], 
     axes[1].set_title("Vector env throughput: physics steps/s")
     for ax in axes:
         ax.legend(fontsize=7, loc="best")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 __all__ = [
@@ -239,7 +179,5 @@ __all__ = [
     "plot_vector",
     "short_name",
     "single_table",
-    "target_row",
-    "targets_table",
     "vector_table",
 ]

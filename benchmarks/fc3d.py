@@ -131,7 +131,7 @@ def markdown(record: dict[str, Any]) -> str:
     ]
     counts = ", ".join(f"{m} {c}" for m, c in record["solved_by_method"].items())
     return (
-        report.markdown_table(header, body)
+        report.markdown_table(body, header)
         + f"\n\nConverged to {TOL:g}: {counts}; by at least one method "
         f"{record['solved_by_any']} of {len(record['problems'])}."
     )
@@ -159,9 +159,7 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
     ax_t.invert_yaxis()
     ax_t.legend(fontsize=8, title="grey fill: not converged", title_fontsize=7)
     fig.suptitle(f"FC3D on the Siconos peer problems, tol {TOL:g}, from r = 0")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    report.save_figure(fig, path, dpi=120)
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -21,23 +21,9 @@ SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
 
 
 def target_rows(name: str, record: dict[str, Any]) -> list[dict[str, Any]]:
-    """The ``targets`` entries of one record, in one schema.
-
-    Two spellings exist: ``measured_us``/``threshold_us`` (µs, lower is better, engine) and
-    ``measured``/``threshold``/``unit``/``comparison`` (the others).
-    """
-    rows = []
-    for target in record.get("targets") or []:
-        microseconds = "measured_us" in target
-        rows.append({
-            "benchmark": name, "target": target["target"],
-            "measured": target["measured_us"] if microseconds else target.get("measured"),
-            "threshold": target["threshold_us"] if microseconds else target.get("threshold"),
-            "unit": "µs" if microseconds else target.get("unit", ""),
-            "comparison": "≤" if microseconds else target.get("comparison", ""),
-            "met": bool(target.get("met")), "note": target.get("note", ""),
-        })  # fmt: skip
-    return rows
+    """The ``targets`` of one record (``benchmarks.report.target_row``), with the benchmark."""
+    return [{"benchmark": name, **target, "met": bool(target.get("met"))}
+            for target in record.get("targets") or []]
 
 
 def stress_row(record: dict[str, Any]) -> dict[str, Any]:
@@ -117,11 +103,11 @@ def write_headline(folder: Path) -> str:
         text = f"no benchmark results with targets in {folder}"
     else:
         text = markdown_table(
-            ["benchmark", "target", "measured", "target value", "met", "note"],
             [[r["benchmark"], r["target"], f"{_number(r['measured'])} {r['unit']}".strip(),
               "(comparison)" if r["threshold"] is None
               else f"{r['comparison']} {_number(r['threshold'])} {r['unit']}".strip(),
               "yes" if r["met"] else "**no**", r["note"]] for r in rows],
+            ["benchmark", "target", "measured", "target value", "met", "note"],
         )  # fmt: skip
     (folder / "headline.md").write_text(text + "\n")
     return text

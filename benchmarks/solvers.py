@@ -27,6 +27,7 @@ import numpy as np
 
 from benchmarks import entries as E
 from benchmarks import report
+from benchmarks import solvers_report as R
 from benchmarks.problems import (
     FAMILIES,
     Problem,
@@ -146,27 +147,18 @@ def size_study(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
 
 def _progress_cells(records: Sequence[dict[str, Any]]) -> str:
     """``entry median-µs`` for each entry of one (family, n), median over instances."""
-    rows = report.aggregate_size_study(records)
+    rows = R.aggregate_size_study(records)
     return ", ".join(f"{r['entry']} {report.format_us(r['time_median_s'])} µs" for r in rows)
 
 
 def comparison_problems(config: BenchConfig, log: Progress) -> list[Problem]:
     """The Siconos peer LCP files (if present) and the random problems n = 10, 20, ..., 100."""
     peers = peer_lcp_problems()
-    if peers:
-        log(f"peer data: {len(peers)} LCP files from {peer_data_dir() / 'lcp'}")
-    else:
-        log(
-            f"peer data: {peer_data_dir() / 'lcp'} absent; skipping the Siconos files "
-            "(set MDI_ENVS_PEER_DATA to the siconos folder to include them)"
-        )
-    randoms = [
-        random_problem(f, n, i)
-        for f in FAMILIES
-        for n in config.peer_sizes
-        for i in range(config.peer_instances)
-    ]
-    return peers + randoms
+    log(f"peer data: {len(peers)} LCP files from {peer_data_dir() / 'lcp'}" if peers else
+        f"peer data: {peer_data_dir() / 'lcp'} absent; skipping the Siconos files (set "
+        "MDI_ENVS_PEER_DATA to the siconos folder to include them)")
+    return peers + [random_problem(f, n, i) for f in FAMILIES for n in config.peer_sizes
+                    for i in range(config.peer_instances)]
 
 
 FIXED_COST_PROBLEMS = (
@@ -178,96 +170,27 @@ FIXED_COST_PROBLEMS = (
 """n = 2 problems on which a call's time is almost all fixed cost (dispatch, checks, result)."""
 
 
-def measure_fixed_cost(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
-    """Time per call of the three Lemke entries on the n = 2 problems (interleaved)."""
+def compare_lemke(problems: Sequence[Problem], plan: TimingPlan, log: Progress
+                  ) -> list[dict[str, Any]]:  # fmt: skip
+    """Our Lemke (driver and compiled entry) against QuantEcon's, interleaved, per problem.
+
+    Each row: name, family, n, per entry (``driver``, ``kernel``, ``quantecon``) its time and
+    outcome, and the time ratios ``ratio_driver`` and ``ratio_kernel`` (ours / QuantEcon).
+    """
     keys = {"driver": E.DRIVER_LEMKE, "kernel": E.KERNEL, "quantecon": E.QUANTECON}
     rows = []
-    for problem in FIXED_COST_PROBLEMS:
-        measured = time_problem(problem, list(keys.values()), config.peer_plan)
-        row: dict[str, Any] = {"name": problem.name, "n": problem.n}
-        row.update({key: measured[entry.name] for key, entry in keys.items()})
-        rows.append(row)
-        log(
-            f"fixed cost {problem.name}: "
-            + ", ".join(
-                f"{key} {report.format_us(row[key]['time']['median_s'])} µs" for key in keys
-            )
-        )
-    return rows
-
-
-def compare_with_quantecon(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
-    """Our Lemke (driver and compiled entry) against QuantEcon's, interleaved, per problem."""
-    keys = {"driver": E.DRIVER_LEMKE, "kernel": E.KERNEL, "quantecon": E.QUANTECON}
-    rows = []
-    for problem in comparison_problems(config, log):
-        measured = time_problem(problem, list(keys.values()), config.peer_plan)
+    for problem in problems:
+        measured = time_problem(problem, list(keys.values()), plan)
         row: dict[str, Any] = {"name": problem.name, "family": problem.family, "n": problem.n}
         row.update({key: measured[entry.name] for key, entry in keys.items()})
         qe_time = row["quantecon"]["time"]["median_s"]
         row["ratio_driver"] = row["driver"]["time"]["median_s"] / qe_time
         row["ratio_kernel"] = row["kernel"]["time"]["median_s"] / qe_time
         rows.append(row)
-        log(
-            f"vs QuantEcon {problem.name} (n={problem.n}): driver/QE "
-            f"{report.format_ratio(row['ratio_driver'])}, lemke_solve/QE "
-            f"{report.format_ratio(row['ratio_kernel'])}; QE status "
-            f"{row['quantecon']['outcome']['status']}"
-        )
+        log(f"{problem.name} (n={problem.n}): " + ", ".join(
+            f"{key} {report.format_us(row[key]['time']['median_s'])} µs" for key in keys)
+            + f"; QE status {row['quantecon']['outcome']['status']}")
     return rows
-
-
-def markdown_report(
-    record: dict[str, Any], aggregates: list[dict[str, Any]], summary: list[dict[str, Any]]
-) -> str:
-    """All result tables of the run, as printed to stdout and pasted into the README."""
-    machine = record["machine"]
-    first = record["first_call"]
-    lines = [
-        f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
-        f"numpy {machine['versions']['numpy']}, numba {machine['versions']['numba']}, "
-        f"quantecon {machine['versions']['quantecon']}; total {record['run_time_s']:.0f} s"
-        f"{' (--quick)' if record['config']['quick'] else ''}.",
-        "",
-        "**First call per entry** (fresh interpreter; ms):",
-        "",
-        _first_call_table(first),
-        "",
-        report.size_tables(aggregates, SIZE_STUDY_COLUMNS),
-        "",
-        "**Lemke vs QuantEcon, per problem** (median time per solve; residuals recomputed with "
-        "`lcp_residual`; our pivots/status/residual are those of `lemke_solve`, which the driver "
-        "returns unchanged)",
-        "",
-        report.peer_table(record["quantecon_comparison"]["problems"]),
-        "",
-        "**Median time ratio ours / QuantEcon** (< 1: ours faster)",
-        "",
-        report.ratio_table(summary),
-        "",
-        "**Fixed cost per call at n = 2** (median µs per call, interleaved rounds)",
-        "",
-        report.fixed_cost_table(record["fixed_cost"]),
-    ]
-    return "\n".join(lines)
-
-
-def _first_call_table(first: dict[str, Any]) -> str:
-    """Markdown table: entry x probe (warm / cold cache) of first-call milliseconds."""
-    probes = [p for p in first if "first_call_s" in first[p]]
-    if not probes:
-        return "(first-call probe failed: " + str(first) + ")"
-    names = list(first[probes[0]]["first_call_s"])
-    header = ["entry", *(f"first call, {p.replace('_', ' ')}" for p in probes), "second call"]
-    rows = [
-        [
-            name,
-            *(f"{first[p]['first_call_s'][name] * 1e3:.1f}" for p in probes),
-            f"{first[probes[0]]['second_call_s'][name] * 1e3:.3f}",
-        ]
-        for name in names
-    ]
-    return report.markdown_table(header, rows)
 
 
 def run(config: BenchConfig, output: Path, quick: bool) -> str:
@@ -281,27 +204,28 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
     log(f"LCP solver benchmark ({'quick' if quick else 'full'}) -> {output}")
     record["first_call"] = measure_first_calls(config, log)
     warm_up([E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)])
-    record["fixed_cost"] = measure_fixed_cost(config, log)
+    record["fixed_cost"] = [{k: v for k, v in row.items() if not k.startswith(("family", "ratio"))}
+                            for row in compare_lemke(FIXED_COST_PROBLEMS, config.peer_plan, log)]
     records = size_study(config, log)
-    aggregates = report.aggregate_size_study(records)
+    aggregates = R.aggregate_size_study(records)
     record["size_study"] = {"records": records, "aggregates": aggregates}
-    rows = compare_with_quantecon(config, log)
-    summary = report.ratio_summary(rows)
+    rows = compare_lemke(comparison_problems(config, log), config.peer_plan, log)
+    summary = R.ratio_summary(rows)
     record["quantecon_comparison"] = {
         "quantecon_max_iter": E.QUANTECON_MAX_ITER,
         "problems": rows,
         "median_ratios": summary,
     }
-    report.plot_time_vs_size(aggregates, SIZE_STUDY_COLUMNS, output / "solvers_time_vs_size.png")
-    report.plot_residual_vs_size(
-        aggregates, SIZE_STUDY_COLUMNS, output / "solvers_residual_vs_size.png"
-    )
-    report.plot_ratios(rows, output / "lemke_vs_quantecon.png")
+    R.plot_by_entry(aggregates, SIZE_STUDY_COLUMNS, output / "solvers_time_vs_size.png",
+                    "time_median_s")
+    R.plot_by_entry(aggregates, SIZE_STUDY_COLUMNS, output / "solvers_residual_vs_size.png",
+                    "residual_max")
+    R.plot_ratios(rows, output / "lemke_vs_quantecon.png")
     record["machine"]["load_average_at_end"] = load_average()
     record["run_time_s"] = log.elapsed
     report.write_json(record, output / "solvers.json")
     log(f"done in {log.elapsed:.0f} s; wrote solvers.json and 3 plots to {output}")
-    return markdown_report(record, aggregates, summary)
+    return R.markdown_report(record, aggregates, summary, SIZE_STUDY_COLUMNS)
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -29,6 +29,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from benchmarks import report
 from benchmarks.startup_probe import FLOOR
 from benchmarks.timing import Progress, machine_info
 
@@ -156,21 +157,16 @@ def _targets(record: dict[str, Any], env_ids: Sequence[str],
     targets = []
     if ratios:
         worst = max(ratios, key=ratios.__getitem__)
-        targets.append({
-            "target": "warm start to the first env step, every id, gym.make and gym.make_vec: "
-                      "time / Acrobot-v1's (worst case)",
-            "measured": ratios[worst], "threshold": record["target_ratio"], "unit": "×",
-            "comparison": "≤", "met": ratios[worst] <= record["target_ratio"],
-            "note": f"worst: {worst}, {record['warm'][worst]['median']:.2f} s",
-        })
+        targets.append(report.target_row(
+            "warm start to the first env step, every id, gym.make and gym.make_vec: time / "
+            "Acrobot-v1's (worst case)", "≤", record["target_ratio"], "×", ratios[worst],
+            f"worst: {worst}, {record['warm'][worst]['median']:.2f} s"))
     if not record["quick"]:
         seconds = record["compile_all"]["seconds"]
-        targets.append({
-            "target": "mdi-envs compile all on an empty cache", "measured": seconds,
-            "threshold": 30.0, "unit": "s", "comparison": "≤",
-            "met": seconds <= 30.0 and record["compile_all"]["returncode"] == 0,
-            "note": f"{os.cpu_count()} cores",
-        })
+        targets.append(report.target_row(
+            "mdi-envs compile all on an empty cache", "≤", 30.0, "s", seconds,
+            f"{os.cpu_count()} cores",
+            seconds <= 30.0 and record["compile_all"]["returncode"] == 0))
     return targets
 
 
@@ -182,28 +178,30 @@ def table(record: dict[str, Any]) -> str:
              f"{compiled['returncode']})"
              + (f"; again on the warm cache {record['compile_all_warm']['seconds']:.1f} s"
                 if "compile_all_warm" in record else ""), "",
-             "| env id | entry | warm median [s] | warm min [s] | / Acrobot-v1 (target ≤ "
-             f"{record['target_ratio']:g}) | cold [s] |", "|---|---|---|---|---|---|"]
+             report.markdown_table(_table_rows(record))]
+    return "\n".join(lines)
+
+
+def _table_rows(record: dict[str, Any]) -> list[dict[str, str]]:
+    """One row per (env id, entry): warm median and min, ratio to Acrobot-v1, cold."""
+    rows = []
     for key, summary in record["warm"].items():
         env_id, entry = key.rsplit(" ", 1)
         ratio = record["ratios_to_acrobot"].get(key)
         cold = record["cold"].get(key, {}).get("median")
         failed = " (failed: " + summary["errors"][0] + ")" if "errors" in summary else ""
-        lines.append(
-            f"| {env_id} | {entry} | {summary.get('median', float('nan')):.2f}{failed} | "
-            f"{summary.get('min', float('nan')):.2f} | "
-            f"{'-' if ratio is None else f'{ratio:.2f}'} | "
-            f"{'-' if cold is None else f'{cold:.1f}'} |")
-    return "\n".join(lines)
+        rows.append({"env id": env_id, "entry": entry,
+                     "warm median [s]": f"{summary.get('median', float('nan')):.2f}{failed}",
+                     "warm min [s]": f"{summary.get('min', float('nan')):.2f}",
+                     f"/ Acrobot-v1 (target ≤ {record['target_ratio']:g})":
+                     "-" if ratio is None else f"{ratio:.2f}",
+                     "cold [s]": "-" if cold is None else f"{cold:.1f}"})
+    return rows
 
 
 def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
           path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = report.plt
     labels = [env_id.removeprefix("mdi_envs/") for env_id in ids]
     figure, axis = plt.subplots(figsize=(9, 4.5))
     width = 0.8 / (len(entries) + 1)
@@ -226,9 +224,7 @@ def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
     axis.set_title("Start-up time, fresh processes"
                    + (" (quick: warm, one run)" if record["quick"] else ""))
     axis.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    report.save_figure(figure, path, dpi=120)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

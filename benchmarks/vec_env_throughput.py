@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks import report
 from benchmarks.timing import Progress, machine_info
 
 BACKENDS = ("batched adapter", "DummyVecEnv", "SubprocVecEnv")
@@ -111,25 +112,19 @@ def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str
 def markdown(results: Sequence[dict[str, Any]]) -> str:
     """One row per vector env, with its speed relative to the batched adapter's."""
     reference = results[0]["train_steps_per_s"]
-    lines = ["| vector env | set-up [s] | training [steps/s] | vs adapter | rollouts "
-             "[steps/s] | updates [s] |", "|---|---|---|---|---|---|"]  # fmt: skip
-    for r in results:
-        lines.append(f"| {r['backend']} | {r['setup_s']:.1f} | {r['train_steps_per_s']:,.0f} | "
-                     f"{r['train_steps_per_s'] / reference:.2f}x | "
-                     f"{r['rollout_steps_per_s']:,.0f} | {r['update_s']:.1f} |")  # fmt: skip
-    return "\n".join(lines)
+    return report.markdown_table([{
+        "vector env": r["backend"], "set-up [s]": f"{r['setup_s']:.1f}",
+        "training [steps/s]": f"{r['train_steps_per_s']:,.0f}",
+        "vs adapter": f"{r['train_steps_per_s'] / reference:.2f}x",
+        "rollouts [steps/s]": f"{r['rollout_steps_per_s']:,.0f}",
+        "updates [s]": f"{r['update_s']:.1f}"} for r in results])
 
 
 def plot(record: dict[str, Any], path: Path) -> None:
     """Bars: training and rollout steps per second per vector env."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     results = record["results"]
     positions = np.arange(len(results))
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = report.plt.subplots(figsize=(7, 4))
     ax.bar(positions - 0.2, [r["train_steps_per_s"] for r in results], 0.4, color="C0",
            label="training (rollouts + updates)")  # fmt: skip
     ax.bar(positions + 0.2, [r["rollout_steps_per_s"] for r in results], 0.4, color="C1",
@@ -140,9 +135,7 @@ def plot(record: dict[str, Any], path: Path) -> None:
                  f"{record['results'][0]['timesteps']:,} steps each")  # fmt: skip
     ax.legend()
     ax.grid(alpha=0.3, axis="y")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    report.save_figure(fig, path, dpi=110)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 
 from benchmarks.engine_report import brake_stop_table
-from benchmarks.report import load_average_text, markdown_table, plt
+from benchmarks.report import format_number as _format
+from benchmarks.report import markdown_table, plt, run_line, save_figure, targets_table
 
 ERROR_FLOOR = 1e-17
 """Exactly-zero errors are drawn at this value on log axes."""
@@ -65,27 +66,6 @@ def series_title(series: str) -> str:
     method, _, case = series.partition(":")
     title = SERIES_TITLES.get(method, method)
     return f"{title} · {case}" if case else title
-
-
-def target_row(name: str, threshold: str, measured: float | int | None, met: bool | None,
-               note: str = "") -> dict[str, Any]:
-    """One target check (``met`` None: not measured)."""
-    return {"target": name, "threshold": threshold, "measured": measured, "met": met,
-            "note": note}
-
-
-def _format(value: float | int | None) -> str:
-    if value is None or (isinstance(value, float) and not math.isfinite(value)):
-        return "–"
-    if isinstance(value, int):
-        return str(value)
-    if value == 0.0:
-        return "0"
-    return f"{value:.3g}" if 1e-2 <= abs(value) < 1e4 else f"{value:.2e}"
-
-
-def _mark(met: bool | None) -> str:
-    return "–" if met is None else ("✓" if met else "✗")
 
 
 # ---------------------------------------------------------------------- equal-time comparison
@@ -169,13 +149,6 @@ def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
 
 
 # ---------------------------------------------------------------------------------- Markdown
-def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
-    """Markdown: target, threshold, measured, met, note."""
-    rows = [[t["target"], t["threshold"], _format(t["measured"]), _mark(t["met"]), t["note"]]
-            for t in targets]
-    return markdown_table(["target", "threshold", "measured", "met", "note"], rows)
-
-
 def _details(p: Mapping[str, Any]) -> str:
     """The point's secondary measurements as short text."""
     parts = []
@@ -205,7 +178,7 @@ def scene_table(points: Sequence[Mapping[str, Any]]) -> str:
              "–" if p["wall_time_s"] is None else _format(p["wall_time_s"] * 1e3),
              _format(p.get("error")), _details(p)]
             for p in points]
-    return markdown_table(["series", "step / tolerance", "wall time ms", "error", "details"], rows)
+    return markdown_table(rows, ["series", "step / tolerance", "wall time ms", "error", "details"])
 
 
 def comparison_table(comparison: Mapping[str, Any]) -> str:
@@ -213,21 +186,13 @@ def comparison_table(comparison: Mapping[str, Any]) -> str:
     rows = [[f"{r['dt']:g}", _format(r["wall_time_s"] * 1e3), _format(r["error"]),
              _format(r["mujoco_error"]), r["how"], _format(r["ratio"])]
             for r in comparison["rows"]]
-    return markdown_table(["our dt [s]", "wall time ms", "our error", "MuJoCo error there",
-                           "how", "MuJoCo / ours"], rows)
+    return markdown_table(rows, ["our dt [s]", "wall time ms", "our error", "MuJoCo error there",
+                                 "how", "MuJoCo / ours"])
 
 
 def markdown_report(record: Mapping[str, Any]) -> str:
     """The targets, the equal-time comparison and one table per scene."""
-    machine = record["machine"]
-    versions = machine["versions"]
-    lines = [
-        f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
-        f"numpy {versions.get('numpy')}, numba {versions.get('numba')}, scipy "
-        f"{versions.get('scipy')}, mujoco {versions.get('mujoco')}; total "
-        f"{record['run_time_s']:.0f} s{' (--quick)' if record['config']['quick'] else ''}; "
-        f"{load_average_text(machine)}.",
-    ]
+    lines = [run_line(record, ("numpy", "numba", "scipy", "mujoco"))]
     if record["notes"]:
         lines += ["", *(f"* {note}" for note in record["notes"])]
     lines += ["", "**Targets** (reported, not enforced)", "", targets_table(record["targets"])]
@@ -246,7 +211,7 @@ def markdown_report(record: Mapping[str, Any]) -> str:
         rows = [[c["model"], c["method"], f"{c['first_step_batch_s']:.1f}"]
                 for c in record["compile"]]
         lines += ["", "**Compile time** (first step_batch call per kernel, excluded from every "
-                  "wall time)", "", markdown_table(["model", "method", "seconds"], rows)]
+                  "wall time)", "", markdown_table(rows, ["model", "method", "seconds"])]
     for scene, title in SCENE_TITLES.items():
         points = [p for p in record["points"] if p["scene"] == scene]
         if points:
@@ -281,7 +246,7 @@ def _reference_lines(scene: str, record: Mapping[str, Any]) -> list[str]:
         return ["", f"MuJoCo ball contact: solref (timeconst {first['solref'][0]:g} s, "
                 "dampratio), solimp (" + ", ".join(f"{x:g}" for x in first["solimp"][:3])
                 + "); effective restitution = sqrt(rebound apex / drop) of a 0.5 m drop:", "",
-                markdown_table(["series", "dt [s]", "dampratio", "ε_eff", "note"], rows)]
+                markdown_table(rows, ["series", "dt [s]", "dampratio", "ε_eff", "note"])]
     return []
 
 
@@ -290,12 +255,6 @@ def _zero_floor(points: Sequence[Mapping[str, Any]]) -> float:
     """Where errors of exactly 0 are drawn: a decade below the smallest positive error."""
     positive = [p["error"] for p in points if p.get("error")]
     return min(ERROR_FLOOR, 0.1 * min(positive)) if positive else ERROR_FLOOR
-
-
-def _save(fig: Any, path: Path) -> None:
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
 
 
 def _style(series: str) -> dict[str, Any]:
@@ -335,7 +294,7 @@ def plot_scene(points: Sequence[Mapping[str, Any]], scene: str, path: Path) -> N
     if any(p.get("error") == 0.0 for p in points):
         note += f"; errors of exactly 0 drawn at {floor:.0e}"
     ax.set_xlabel(note + ")")
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def plot_ball_convergence(points: Sequence[Mapping[str, Any]], path: Path) -> None:
@@ -362,7 +321,7 @@ def plot_ball_convergence(points: Sequence[Mapping[str, Any]], path: Path) -> No
     ax.set_title("Bouncing ball: convergence in dt", fontsize=9)
     ax.grid(True, which="both", lw=0.3, alpha=0.5)
     ax.legend(fontsize=7)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def plot_all(points: Sequence[Mapping[str, Any]], scenes: Sequence[str], output: Path
@@ -391,5 +350,4 @@ __all__ = [
     "pareto_front",
     "plot_all",
     "series_title",
-    "target_row",
 ]

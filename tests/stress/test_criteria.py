@@ -1,9 +1,7 @@
-"""Tests of the numerical stress test (``benchmarks/stress.py``) in its quick mode.
+"""The stress criteria fail on broken inputs; ``mdi-envs bench stress`` reports case records.
 
-One module-scoped run of ``run(tmp, quick=True)`` (it compiles the block's and the manipulator's
-step kernels: 20-50 s in a fresh process) feeds the checks on its outcome and outputs; the
-criterion evaluators are then shown to fail on deliberately broken inputs, so that a passing
-case means something.
+The criterion evaluators are shown to fail on deliberately broken inputs, so that a passing case
+means something; the report (table, JSON, plot) is checked on hand-made records.
 """
 
 from __future__ import annotations
@@ -12,16 +10,10 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
-
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:  # ``benchmarks`` is a folder of the repository, not installed
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.stress import (  # noqa: E402
+from stress.cases import (
     Trace,
     at_least,
     at_most,
@@ -29,60 +21,29 @@ from benchmarks.stress import (  # noqa: E402
     health_criteria,
     lcp_criteria,
     lcp_outcome,
-    markdown_report,
-    run,
+    plan,
 )
-from benchmarks.stress_report import margin  # noqa: E402
-from mdi_envs.solvers.status import SolverStatus  # noqa: E402
+
+from mdi_envs.solvers.status import SolverStatus
+
+ROOT = Path(__file__).resolve().parents[2]
+if str(ROOT) not in sys.path:  # ``benchmarks`` is a folder of the repository, not installed
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks import stress as bench_stress  # noqa: E402
 
 
-@pytest.fixture(scope="module")
-def outcome(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], Path]:
-    """The quick run's record and its output folder."""
-    output = tmp_path_factory.mktemp("stress")
-    return run(output, quick=True, log=lambda message: None), output
-
-
-def test_every_stress_case_passes(outcome: tuple[dict[str, Any], Path]) -> None:
-    record, _ = outcome
-    failing = [f"{c['name']}: {name} {v['value']:.3g} (limit {v['relation']} {v['limit']:.3g})"
-               for c in record["cases"] for name, v in c["criteria"].items() if not v["passed"]]
-    assert not failing, "failing stress cases:\n" + "\n".join(failing)
-    assert record["passed"] and record["num_failed"] == 0
-
-
-def test_every_family_is_run(outcome: tuple[dict[str, Any], Path]) -> None:
-    record, _ = outcome
-    families = {c["family"] for c in record["cases"]}
-    assert families == {"zeno", "brake_toggle", "dt_sweep", "mu_sweep", "overdrive", "lcp",
-                        "long_horizon"}
-    zeno = [c for c in record["cases"] if c["family"] == "zeno"]
-    assert [(c["parameters"]["eps"], c["parameters"]["locate_impacts"]) for c in zeno] == [
-        (eps, located) for eps in (0.0, 0.3, 0.6, 0.9, 0.99) for located in (False, True)]
-    dts = {c["parameters"]["dt"] for c in record["cases"] if c["family"] == "dt_sweep"}
+def test_plan_covers_every_family_once_per_name() -> None:
+    cases = plan()
+    names = [c.name for c in cases]
+    assert len(names) == len(set(names))
+    assert {c.family for c in cases} >= {"zeno", "brake_toggle", "dt_sweep", "mu_sweep",
+                                         "overdrive", "lcp", "long_horizon"}
+    zeno = [c.args for c in cases if c.family == "zeno"]
+    assert zeno == [(eps, located) for eps in (0.0, 0.3, 0.6, 0.9, 0.99)
+                    for located in (False, True)]
+    dts = {c.args[1] for c in cases if c.family == "dt_sweep"}
     assert min(dts) == 1e-6 and max(dts) == 0.1
-
-
-def test_outputs_are_written(outcome: tuple[dict[str, Any], Path]) -> None:
-    record, output = outcome
-    assert (output / "stress.png").stat().st_size > 10_000
-    saved = json.loads((output / "stress.json").read_text())
-    assert saved["num_cases"] == len(saved["cases"]) == len(record["cases"])
-    assert saved["machine"]["cpu_count"] and saved["run_time_s"] > 0
-    for case in saved["cases"]:
-        assert case["criteria"], case["name"]
-        for criterion in case["criteria"].values():
-            assert set(criterion) == {"value", "limit", "relation", "passed"}
-        assert case["passed"] == all(c["passed"] for c in case["criteria"].values())
-
-
-def test_markdown_report_has_one_row_per_case(outcome: tuple[dict[str, Any], Path]) -> None:
-    record, _ = outcome
-    text = markdown_report(record)
-    rows = [line for line in text.splitlines() if line.startswith("| ") and "---" not in line]
-    assert len(rows) == len(record["cases"]) + 1  # plus the header
-    for case in record["cases"]:
-        assert f"| {case['name']} |" in text
 
 
 def _trace(q: np.ndarray, status: np.ndarray) -> Trace:
@@ -123,6 +84,7 @@ def test_criteria_fail_on_non_finite_values() -> None:
     assert not at_most(math.nan, 1.0)["passed"] and not at_least(math.nan, 1.0)["passed"]
     assert not at_most(math.inf, 1.0)["passed"]
     assert at_least(2, 1)["passed"] and not at_least(0, 1)["passed"]
+    margin = bench_stress.margin
     assert margin(at_most(0.5, 1.0)) == 0.5 and margin(at_most(math.nan, 1.0)) > 1.0
     assert margin(at_most(0, 0)) < 1.0 < margin(at_most(3, 0))
 
@@ -147,3 +109,21 @@ def test_lcp_outcome_reports_infeasible_problem_honestly() -> None:
     for method in ("lemke", "enumerative", "pgs", "newton_fb"):
         result = lcp_outcome(M, q, method)
         assert result["honest"] and result["status"] != "CONVERGED", result
+
+
+def test_report_of_a_failing_case(tmp_path: Path) -> None:
+    cases = [{"family": "lcp", "name": "lcp good", "parameters": {"n": 2, "eps": 0.25},
+              "metrics": {}, "criteria": {"dishonest_results": at_most(0, 0)}, "passed": True},
+             {"family": "lcp", "name": "lcp bad", "parameters": {"dt": [1e-3, 2e-3]},
+              "metrics": {}, "criteria": {"energy": at_most(math.inf, 1.0)}, "passed": False}]
+    record = {"cases": cases, "config": {"quick": True}, "run_time_s": 1.0, "notes": ["n1"]}
+    text = bench_stress.markdown_report(record)
+    assert "1 of 2 cases pass; failing: lcp bad" in text and "* n1" in text
+    rows = [line for line in text.splitlines() if line.startswith("| ")]
+    assert len(rows) == 3 and "**energy inf <= 1 FAIL**" in rows[2]
+    assert "eps=0.25" in rows[1] and "dt=0.001,0.002" in rows[2]
+    bench_stress.plot_margins(cases, tmp_path / "stress.png")
+    assert (tmp_path / "stress.png").stat().st_size > 5_000
+    bench_stress.report.write_json(bench_stress.report.json_safe(record), tmp_path / "s.json")
+    assert json.loads((tmp_path / "s.json").read_text())["cases"][1]["criteria"]["energy"][
+        "value"] == "inf"
