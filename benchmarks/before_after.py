@@ -11,8 +11,9 @@ steps per second): the median over the rounds per tree and their ratio. Each run
 machine's phase did. Each round also runs ``benchmarks.in_place_probe`` on both mission models:
 the minimum over 300 batches is the code's speed, robust to those phases. Writes
 ``before_after.json`` and ``before_after.png``, prints a Markdown table. Alternating the trees
-spreads this VM's slow phases over both. About 3 min per round (plus the before tree's
-compilation: it has no disk cache).
+spreads this VM's slow phases over both (``benchmarks.timing`` measures why: pyperf's
+``compare_to`` and asv compare runs made one after the other). About 3 min per round (plus the
+before tree's compilation: it has no disk cache).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from benchmarks import report
 from benchmarks.timing import Progress, machine_info
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -134,20 +136,14 @@ def run(before: Path, rounds: int, output: Path) -> str:
     output.mkdir(parents=True, exist_ok=True)
     (output / "before_after.json").write_text(json.dumps(record, indent=2))
     _plot(rows, output / "before_after.png")
-    lines = ["| target | unit | before (median) | after (median) | slowdown after/before "
-             f"(limit {LIMIT:g}) |", "|---|---|---|---|---|"]
-    lines += [f"| {row['target']} | {row['unit']} | {row['before']:.4g} | {row['after']:.4g} "
-              f"| {row['slowdown']:.3f}{'' if row['ok'] else ' (over)'} |" for row in rows]
-    return "\n".join(lines)
+    return report.markdown_table([{
+        "target": row["target"], "unit": row["unit"], "before (median)": f"{row['before']:.4g}",
+        "after (median)": f"{row['after']:.4g}", f"slowdown after/before (limit {LIMIT:g})":
+        f"{row['slowdown']:.3f}{'' if row['ok'] else ' (over)'}"} for row in rows])
 
 
 def _plot(rows: list[dict[str, Any]], path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figure, axis = plt.subplots(figsize=(9, 0.35 * len(rows) + 1.5))
+    figure, axis = report.plt.subplots(figsize=(9, 0.35 * len(rows) + 1.5))
     labels = [row["target"][:70] for row in rows]
     axis.barh(range(len(rows)), [row["slowdown"] for row in rows],
               color=["tab:green" if row["ok"] else "tab:red" for row in rows])
@@ -156,9 +152,7 @@ def _plot(rows: list[dict[str, Any]], path: Path) -> None:
     axis.set_yticks(range(len(rows)), labels, fontsize=7)
     axis.set_xlabel("after / before (time; inverse for rates): > 1 is slower")
     axis.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    report.save_figure(figure, path, dpi=120)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -24,8 +24,6 @@ results tables (the ones in ``benchmarks/README.md``) on stdout. Parts:
 
 from __future__ import annotations
 
-import argparse
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -51,9 +49,12 @@ from benchmarks.timing import (
     VERSIONED_PACKAGES,
     Progress,
     TimingPlan,
-    load_average,
+    arguments,
+    checkpoint,
+    finish,
+    load_text,
     machine_info,
-    speed_probe,
+    seconds,
     time_interleaved,
 )
 from mdi_envs.mechanics.compiled import compile_equations
@@ -160,45 +161,29 @@ TARGETS_US = {"manipulator_batched": 0.1, "manipulator_python": 1.0, "diff_drive
 """The brief's targets [µs]."""
 
 
-def _seconds(action: Callable[[], Any]) -> float:
-    """Wall-clock seconds of one call."""
-    start = time.perf_counter()
-    action()
-    return time.perf_counter() - start
-
-
 def _first_batch(st: MoreauJeanStepper, case: ModelCase) -> None:
     """One tiny ``step_batch`` call (compiles it)."""
     BatchedCall(st, batch_arrays(case, 2), 1)()
 
 
-def compile_steppers(cases: list[ModelCase], log: Progress, notes: list[str]
-                     ) -> tuple[list[ModelCase], dict[str, MoreauJeanStepper], list[dict]]:
+def compile_steppers(cases: list[ModelCase], log: Progress
+                     ) -> tuple[dict[str, MoreauJeanStepper], list[dict]]:  # fmt: skip
     """Build each default stepper and time its first ``step`` and ``step_batch`` calls.
 
-    A model whose first call raises ``NotImplementedError`` is dropped with a note.
-
     Returns:
-        (the cases kept, label -> stepper, one compile record per stepper).
+        (label -> stepper, one compile record per stepper).
     """
-    kept, steppers, records = [], {}, []
+    steppers, records = {}, []
     for case in cases:
         log(f"compiling {case.label} (first step, then first step_batch) ...")
-        try:
-            st = stepper(case)
-            arrays = case.scenes[0].arrays()
-            step_s = _seconds(lambda st=st, arrays=arrays: st.step(*arrays))
-            batch_s = _seconds(lambda st=st, case=case: _first_batch(st, case))
-        except NotImplementedError as error:
-            notes.append(f"{case.label} skipped: NotImplementedError: {error}")
-            log(notes[-1])
-            continue
-        kept.append(case)
-        steppers[case.label] = st
+        st = steppers[case.label] = stepper(case)
+        arrays = case.scenes[0].arrays()
+        step_s = seconds(lambda st=st, arrays=arrays: st.step(*arrays))
+        batch_s = seconds(lambda st=st, case=case: _first_batch(st, case))
         records.append({"stepper": f"{case.label} (default shortcuts)", "step_s": step_s,
                         "step_batch_s": batch_s})
         log(f"  {case.label}: first step {step_s:.1f} s, first step_batch {batch_s:.1f} s")
-    return kept, steppers, records
+    return steppers, records
 
 
 IN_PLACE_STEPS_PER_CALL = 200
@@ -355,7 +340,7 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
         rows += measured
         log(f"batched N = {n}: " + ", ".join(
             f"{r['model']} {report.format_us_fine(r['per_copy_step_s'])} µs (x{r['substeps']})"
-            for r in measured) + f"; load {_load_text()}")
+            for r in measured) + f"; load {load_text()}")
     return rows
 
 
@@ -412,10 +397,10 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
             if key not in variants:
                 log(f"compiling {case.label} with {R.shortcuts_text(sc.off)} ...")
                 st = stepper(case, sc.off)
-                seconds = _seconds(lambda st=st, case=case: _first_batch(st, case))
+                batch_s = seconds(lambda st=st, case=case: _first_batch(st, case))
                 compile_records.append({"stepper": f"{case.label} ({R.shortcuts_text(sc.off)})",
-                                        "step_s": None, "step_batch_s": seconds})
-                log(f"  first step_batch {seconds:.1f} s")
+                                        "step_s": None, "step_batch_s": batch_s})
+                log(f"  first step_batch {batch_s:.1f} s")
                 variants[key] = st
             off = BatchedCall(variants[key], on_arrays, on.num_substeps)
             difference: float | None = _state_difference(on, off)
@@ -510,12 +495,6 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
     return targets
 
 
-def _load_text() -> str:
-    """The 1-minute load average, for progress lines."""
-    load = load_average()
-    return f"{load[0]:.2f}" if load else "n/a"
-
-
 def run(config: EngineConfig, output: Path, quick: bool) -> str:
     """Run the whole benchmark, write the outputs and return the Markdown report."""
     log = Progress()
@@ -529,22 +508,18 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
     }
     notes = record["notes"]
 
-    def checkpoint(section: str) -> None:
-        record["load_log"].append({"section": section, "elapsed_s": log.elapsed,
-                                   "load_average": load_average()})
+    def section(name: str) -> None:
+        checkpoint(record, name, log.elapsed)
 
-    log(f"engine benchmark ({'quick' if quick else 'full'}) -> {output}; load {_load_text()}")
-    cases, case_notes = model_cases(config.models)
-    notes += case_notes
-    for note in case_notes:
-        log(note)
+    log(f"engine benchmark ({'quick' if quick else 'full'}) -> {output}; load {load_text()}")
+    cases = model_cases(config.models)
     mujoco, mujoco_note = import_mujoco()
     arm = MujocoArm(mujoco) if mujoco is not None else None
     if mujoco_note:
         notes.append(mujoco_note)
         log(mujoco_note)
-    checkpoint("compile")
-    cases, steppers, compile_records = compile_steppers(cases, log, notes)
+    section("compile")
+    steppers, compile_records = compile_steppers(cases, log)
     record["models"] = [R.case_record(c) for c in cases]
     if arm is not None and "manipulator" in steppers:
         st = steppers["manipulator"]
@@ -553,21 +528,21 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
         record["mujoco_mass_matrix_difference"] = arm.mass_matrix_check(ours)
         log(f"MuJoCo arm: |M_mujoco - T^T M_ours T| = "
             f"{record['mujoco_mass_matrix_difference']:.1e}")
-    checkpoint("single step")
+    section("single step")
     single = single_step_study(cases, steppers, arm, config, log)
-    checkpoint("per scene")
+    section("per scene")
     scenes = scene_study(cases, steppers, arm, config, log)
-    checkpoint("batched")
+    section("batched")
     batched = batched_study(cases, steppers, arm, config, log)
-    checkpoint("substeps")
+    section("substeps")
     substeps = substeps_study(cases, steppers, config, log)
-    checkpoint("shortcuts")
+    section("shortcuts")
     shortcuts = shortcut_study(cases, steppers, config, log, compile_records)
-    checkpoint("brake stop")
+    section("brake stop")
     brake = brake_stop_study(steppers, arm, log)
     if arm is not None:
         arm.close()
-    checkpoint("end")
+    section("end")
     record.update({
         "compile": compile_records,
         "single_step": single,
@@ -581,9 +556,7 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
     R.plot_batched(batched, substeps, TARGETS_US, output / "engine_batched.png")
     R.plot_single_step(single, scenes, TARGETS_US, output / "engine_single_step.png")
     R.plot_shortcuts(shortcuts, output / "engine_shortcuts.png")
-    record["machine"]["load_average_at_end"] = load_average()
-    record["machine"]["speed_probe_at_end"] = speed_probe()
-    record["run_time_s"] = log.elapsed
+    finish(record, log.elapsed, speed=True)
     report.write_json(record, output / "engine.json")
     log(f"done in {log.elapsed:.0f} s; wrote engine.json and 3 plots to {output}")
     return R.markdown_report(record)
@@ -591,14 +564,11 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
-    parser.add_argument("--quick", action="store_true",
-                        help="manipulator and MuJoCo only, small grid and budgets (~20 s)")
-    parser.add_argument("--models", default=None,
-                        help=f"comma-separated models instead of the run's own (of "
-                        f"{', '.join(FULL.models)})")
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, "manipulator and MuJoCo only, small grid and budgets (~20 s)",
+                     "results/bench",
+                     extra=lambda parser: parser.add_argument(
+                         "--models", default=None, help="comma-separated models instead of the "
+                         f"run's own (of {', '.join(FULL.models)})"))
     config = QUICK if args.quick else FULL
     if args.models:
         models = tuple(args.models.split(","))

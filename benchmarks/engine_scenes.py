@@ -4,15 +4,10 @@ A scene is one state and one input of one model (``q, u, tau, brake_bound``). Th
 timings call ``MoreauJeanStepper.step`` on it again and again (the state does not advance); the
 batched timings give copy i of N the scene ``i mod k`` of its model's k scenes and advance all
 copies from there (each timed call starts again from these states).
-
-Every model is found in ``mdi_envs.mechanics`` (the differential-drive robot also in its own
-module while it is not exported there). A model whose stepper raises ``NotImplementedError`` is
-skipped with a note.
 """
 
 from __future__ import annotations
 
-import importlib
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -128,28 +123,8 @@ DIFF_DRIVE_SCENES = (
 )
 
 
-def _diff_drive_class() -> Any | None:
-    """``DiffDriveRobot`` from ``mdi_envs.mechanics`` or its module, or None if absent."""
-    found = getattr(mechanics, "DiffDriveRobot", None)
-    if found is not None:
-        return found
-    try:
-        module = importlib.import_module("mdi_envs.mechanics.models.diff_drive")
-    except ImportError:
-        return None
-    return getattr(module, "DiffDriveRobot", None)
-
-
-def model_cases(names: Sequence[str]) -> tuple[list[ModelCase], list[str]]:
-    """The requested model cases that exist, and notes on those skipped.
-
-    Args:
-        names: labels among ``"ball"``, ``"block"``, ``"manipulator"``, ``"diff_drive"``.
-
-    Returns:
-        (cases in the order asked, notes). The diff-drive case is only returned if its stepper
-        can be built (``MoreauJeanStepper`` raises ``NotImplementedError`` while it cannot).
-    """
+def model_cases(names: Sequence[str]) -> list[ModelCase]:
+    """The model cases of ``names`` (among ball, block, manipulator, diff_drive), in that order."""
     ball = mechanics.BouncingBall
     available = {
         "ball": ModelCase("ball", ball, _ball_scenes(ball.Parameters().radius),
@@ -157,21 +132,9 @@ def model_cases(names: Sequence[str]) -> tuple[list[ModelCase], list[str]]:
         "block": ModelCase("block", mechanics.SlidingBlock, BLOCK_SCENES),
         "manipulator": ModelCase("manipulator", mechanics.BlockableManipulator,
                                  _manipulator_scenes()),
+        "diff_drive": ModelCase("diff_drive", mechanics.DiffDriveRobot, DIFF_DRIVE_SCENES),
     }
-    notes = []
-    if "diff_drive" in names:
-        robot = _diff_drive_class()
-        if robot is None:
-            notes.append("diff_drive skipped: no DiffDriveRobot in mdi_envs.mechanics")
-        else:
-            try:
-                MoreauJeanStepper(robot, time_step=TIME_STEP)
-            except NotImplementedError as error:
-                notes.append(f"diff_drive skipped: MoreauJeanStepper raised "
-                             f"NotImplementedError: {error}")
-            else:
-                available["diff_drive"] = ModelCase("diff_drive", robot, DIFF_DRIVE_SCENES)
-    return [available[n] for n in names if n in available], notes
+    return [available[n] for n in names]
 
 
 def batch_arrays(case: ModelCase, num_copies: int, scenes: Sequence[Scene] | None = None

@@ -25,7 +25,6 @@ used (no kernel of ``mdi_envs`` is parallel).
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import time
@@ -42,9 +41,11 @@ from benchmarks import report
 from benchmarks.timing import (
     Progress,
     TimingPlan,
-    load_average,
+    arguments,
+    checkpoint,
+    finish,
+    load_text,
     machine_info,
-    speed_probe,
     time_interleaved,
 )
 
@@ -289,7 +290,7 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
         log(f"  first step {record['first_step_s']:.2f} s, make {record['first_make_s']:.2f} s,"
             f" frame_skip {record['frame_skip']}")
     calls.update(loops)
-    log(f"single env: {len(calls)} step loops, interleaved; load {_load_text()} ...")
+    log(f"single env: {len(calls)} step loops, interleaved; load {load_text()} ...")
     timed = time_interleaved(calls, config.step_plan)
     for record in records:
         for entry in ("gym.make", "unwrapped"):
@@ -401,7 +402,7 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str]
         rows += measured
         log(f"vector N = {n}: " + ", ".join(
             f"{R.short_name(r['env_id'])} ({r['mode']}) {r['env_steps_per_s']:.3g} env-steps/s"
-            for r in measured) + f"; load {_load_text()}")
+            for r in measured) + f"; load {load_text()}")
     return rows, unavailable
 
 
@@ -441,12 +442,6 @@ def evaluate_targets(single: Sequence[dict[str, Any]], vector: Sequence[dict[str
         TARGETS["manipulator_physics_steps_per_s"], "1/s",
         at[0]["physics_steps_per_s"] if at else None, note))
     return targets
-
-
-def _load_text() -> str:
-    """The 1-minute load average, for progress lines."""
-    load = load_average()
-    return f"{load[0]:.2f}" if load else "n/a"
 
 
 def _pin(cpu: int | None) -> tuple[set[int] | None, dict[str, Any]]:
@@ -494,15 +489,12 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
             "load_log": [],
         }
         log(f"env benchmark ({'quick' if quick else 'full'}) -> {output}; pinned to "
-            f"{pinning['cpus']}; load {_load_text()}")
-        record["load_log"].append({"section": "single env", "elapsed_s": progress.elapsed,
-                                   "load_average": load_average()})
+            f"{pinning['cpus']}; load {load_text()}")
+        checkpoint(record, "single env", progress.elapsed)
         single, unavailable = single_env_study(env_ids, config.peers, config, log)
-        record["load_log"].append({"section": "vector env", "elapsed_s": progress.elapsed,
-                                   "load_average": load_average()})
+        checkpoint(record, "vector env", progress.elapsed)
         vector, vector_unavailable = vector_study(env_ids, config, log)
-        record["load_log"].append({"section": "end", "elapsed_s": progress.elapsed,
-                                   "load_average": load_average()})
+        checkpoint(record, "end", progress.elapsed)
         for item in (*unavailable, *vector_unavailable):
             record["notes"].append(f"{item['env_id']}"
                                    f"{' (' + item['mode'] + ')' if 'mode' in item else ''} "
@@ -516,9 +508,7 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
         })
         R.plot_step(single, unavailable, TARGETS, output / "envs_step.png")
         R.plot_vector(vector, TARGETS, output / "envs_vector.png")
-        record["machine"]["load_average_at_end"] = load_average()
-        record["machine"]["speed_probe_at_end"] = speed_probe()
-        record["run_time_s"] = progress.elapsed
+        finish(record, progress.elapsed, speed=True)
         report.write_json(record, output / "envs.json")
         log(f"done in {progress.elapsed:.0f} s; wrote envs.json, envs_step.png and "
             f"envs_vector.png to {output}")
@@ -530,13 +520,11 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
-    parser.add_argument("--quick", action="store_true",
-                        help="N up to 256 and small budgets (the JIT compile still dominates)")
-    parser.add_argument("--cpu", type=int, default=0,
-                        help="CPU to pin the process to (-1: no pinning)")
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, "N up to 256 and small budgets (the JIT compile dominates)",
+                     "results/bench",
+                     extra=lambda parser: parser.add_argument(
+                         "--cpu", type=int, default=0,
+                         help="CPU to pin the process to (-1: no pinning)"))
     config = QUICK if args.quick else FULL
     config = replace(config, cpu=None if args.cpu < 0 else args.cpu)
     print(run(config, args.output, args.quick))

@@ -17,7 +17,6 @@ and ``fc3d.png`` (time and residual per problem and method) and prints the Markd
 
 from __future__ import annotations
 
-import argparse
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -31,7 +30,7 @@ import numpy as np  # noqa: E402
 
 from benchmarks import report  # noqa: E402
 from benchmarks.problems import peer_data_dir  # noqa: E402
-from benchmarks.timing import Progress, load_average, machine_info  # noqa: E402
+from benchmarks.timing import Progress, arguments, load_average, machine_info  # noqa: E402
 from mdi_envs.solvers import SolverStatus, fc3d_residual, solve_fc3d  # noqa: E402
 from mdi_envs.solvers.siconos_io import read_friction_contact  # noqa: E402
 
@@ -164,12 +163,7 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
-    parser.add_argument(
-        "--quick", action="store_true", help=f"only problems with n <= {QUICK_MAX_N}"
-    )
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, f"only problems with n <= {QUICK_MAX_N}", "results/bench")
     print(run(args.output, args.quick))
 
 

@@ -12,22 +12,15 @@ from __future__ import annotations
 
 import importlib
 import json
-import time
-from typing import Any
 
-
-def _seconds(action: Any) -> float:
-    """Wall-clock seconds of one call of ``action()``."""
-    start = time.perf_counter()
-    action()
-    return time.perf_counter() - start
+from benchmarks.timing import seconds
 
 
 def main() -> None:
     """Measure and print the report as JSON on stdout."""
     import_times = {
-        "mdi_envs.solvers.lcp": _seconds(lambda: importlib.import_module("mdi_envs.solvers.lcp")),
-        "quantecon.optimize": _seconds(lambda: importlib.import_module("quantecon.optimize")),
+        "mdi_envs.solvers.lcp": seconds(lambda: importlib.import_module("mdi_envs.solvers.lcp")),
+        "quantecon.optimize": seconds(lambda: importlib.import_module("quantecon.optimize")),
     }
     from benchmarks import entries
     from benchmarks.problems import random_problem
@@ -35,8 +28,8 @@ def main() -> None:
     problem = random_problem("spd", 5, 0)
     probes = [entries.KERNEL] + [entries.driver_entry(m) for m in entries.LCP_METHODS]
     probes.append(entries.QUANTECON)
-    first_call = {e.name: _seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
-    second_call = {e.name: _seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
+    first_call = {e.name: seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
+    second_call = {e.name: seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
     report = {"import_s": import_times, "first_call_s": first_call, "second_call_s": second_call}
     print(json.dumps(report))
 

@@ -17,7 +17,6 @@ on two 2 x 2 problems (one needing two pivots, one with q >= 0 solved by z = 0).
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -38,7 +37,8 @@ from benchmarks.problems import (
 from benchmarks.timing import (
     Progress,
     TimingPlan,
-    load_average,
+    arguments,
+    finish,
     machine_info,
     probe_first_calls,
     time_interleaved,
@@ -221,8 +221,7 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
     R.plot_by_entry(aggregates, SIZE_STUDY_COLUMNS, output / "solvers_residual_vs_size.png",
                     "residual_max")
     R.plot_ratios(rows, output / "lemke_vs_quantecon.png")
-    record["machine"]["load_average_at_end"] = load_average()
-    record["run_time_s"] = log.elapsed
+    finish(record, log.elapsed)
     report.write_json(record, output / "solvers.json")
     log(f"done in {log.elapsed:.0f} s; wrote solvers.json and 3 plots to {output}")
     return R.markdown_report(record, aggregates, summary, SIZE_STUDY_COLUMNS)
@@ -230,10 +229,7 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path("results/bench"), help="output folder")
-    parser.add_argument("--quick", action="store_true", help="small grid and budgets (~10 s)")
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, "small grid and budgets (~10 s)", "results/bench")
     print(run(QUICK if args.quick else FULL, args.output, args.quick))
 
 

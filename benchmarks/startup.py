@@ -31,7 +31,7 @@ from typing import Any
 
 from benchmarks import report
 from benchmarks.startup_probe import FLOOR
-from benchmarks.timing import Progress, machine_info
+from benchmarks.timing import Progress, arguments, machine_info
 
 REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
 """Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
@@ -229,15 +229,13 @@ def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path("results/bench"),
-                        help="output folder")
-    parser.add_argument("--quick", action="store_true",
-                        help="warm single and vector cases once, on the user's cache")
-    parser.add_argument("--python-path", type=Path, default=None,
-                        help="run the probes on the package in this folder (PYTHONPATH)")
-    parser.add_argument("--repeats", type=int, default=5, help="warm repetitions (full run)")
-    args = parser.parse_args(argv)
+    def extra(parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--python-path", type=Path, default=None,
+                            help="run the probes on the package in this folder (PYTHONPATH)")
+        parser.add_argument("--repeats", type=int, default=5, help="warm repetitions (full run)")
+
+    args = arguments(__doc__, argv, "warm single and vector cases once, on the user's cache",
+                     "results/bench", extra)
     print(run(args.quick, args.output, args.python_path, args.repeats))
     record = json.loads((args.output / "startup.json").read_text())
     failed = [key for key, summary in record["warm"].items() if "errors" in summary]

@@ -11,7 +11,6 @@ Markdown table. Exits with 1 if any case fails.
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -24,7 +23,7 @@ import numpy as np
 import pytest
 
 from benchmarks import report
-from benchmarks.timing import load_average, machine_info
+from benchmarks.timing import arguments, load_average, machine_info
 
 TESTS = Path(__file__).resolve().parents[1] / "tests" / "stress"
 """The folder of the stress cases."""
@@ -164,11 +163,7 @@ def plot_margins(cases: Sequence[Mapping[str, Any]], path: Path) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns 1 if any case fails, else 0."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path("benchmarks/results"))
-    parser.add_argument("--quick", action="store_true",
-                        help="the quick configuration: block and manipulator only")
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, "the quick configuration: block and manipulator only")
     record = run(args.output, args.quick)
     print(markdown_report(record))
     return 0 if record["passed"] else 1

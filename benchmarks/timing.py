@@ -19,6 +19,7 @@ kept, and ``before_after`` alternates the two trees for the same reason.
 
 from __future__ import annotations
 
+import argparse
 import datetime as dt
 import json
 import math
@@ -28,7 +29,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
@@ -238,6 +239,47 @@ def speed_probe(samples: int = 200, number: int = 5000) -> dict[str, float]:
             "slow_fraction": sum(t > 1.5 * fastest for t in times) / samples}
 
 
+def seconds(action: Callable[[], Any]) -> float:
+    """Wall-clock seconds of one call of ``action()``."""
+    start = time.perf_counter()
+    action()
+    return time.perf_counter() - start
+
+
+def load_text() -> str:
+    """The 1-minute load average, for progress lines."""
+    load = load_average()
+    return f"{load[0]:.2f}" if load else "n/a"
+
+
+def checkpoint(record: dict[str, Any], section: str, elapsed_s: float) -> None:
+    """Append the load average at the start of ``section`` to ``record["load_log"]``."""
+    record.setdefault("load_log", []).append(
+        {"section": section, "elapsed_s": elapsed_s, "load_average": load_average()})
+
+
+def finish(record: dict[str, Any], elapsed_s: float, speed: bool = False) -> None:
+    """Close a run's record: load average (and speed probe) at the end, ``run_time_s``."""
+    record["machine"]["load_average_at_end"] = load_average()
+    if speed:
+        record["machine"]["speed_probe_at_end"] = speed_probe()
+    record["run_time_s"] = elapsed_s
+
+
+def arguments(doc: str | None, argv: Sequence[str] | None, quick: str,
+              default_output: str = "benchmarks/results",
+              extra: Callable[[argparse.ArgumentParser], Any] | None = None
+              ) -> argparse.Namespace:  # fmt: skip
+    """The command line of a benchmark module: ``--output``, ``--quick`` (and ``extra``'s)."""
+    parser = argparse.ArgumentParser(description=(doc or "").splitlines()[0])
+    parser.add_argument("--output", type=Path, default=Path(default_output),
+                        help=f"output folder (default: {default_output})")
+    parser.add_argument("--quick", action="store_true", help=quick)
+    if extra is not None:
+        extra(parser)
+    return parser.parse_args(argv)
+
+
 class Progress:
     """Progress lines on stderr, stamped with the seconds since the start of the run."""
 
@@ -275,9 +317,14 @@ __all__ = [
     "Progress",
     "Timed",
     "TimingPlan",
+    "arguments",
+    "checkpoint",
+    "finish",
     "load_average",
+    "load_text",
     "machine_info",
     "probe_first_calls",
+    "seconds",
     "speed_probe",
     "time_interleaved",
 ]

@@ -70,7 +70,6 @@ the ideal brake stops the relative motion in one step (``benchmarks.engine.brake
 
 from __future__ import annotations
 
-import argparse
 import math
 import time
 import traceback
@@ -85,7 +84,14 @@ import numpy as np
 from benchmarks import report
 from benchmarks import work_precision_report as R
 from benchmarks.engine_mujoco import MujocoArm, import_mujoco
-from benchmarks.timing import VERSIONED_PACKAGES, Progress, TimingPlan, load_average, machine_info
+from benchmarks.timing import (
+    VERSIONED_PACKAGES,
+    Progress,
+    TimingPlan,
+    arguments,
+    finish,
+    machine_info,
+)
 from benchmarks.work_precision_mujoco import (
     MujocoArmRun,
     MujocoBall,
@@ -944,8 +950,7 @@ def run(output: Path, quick: bool, log: Log | None = None,
                    "mujoco_ball_calibration": calibrations, "brake_stop": brake,
                    "equal_time": comparison, "targets": targets, "notes": ctx.notes,
                    "failed_sections": ctx.failed_sections})
-    record["machine"]["load_average_at_end"] = load_average()
-    record["run_time_s"] = progress.elapsed
+    finish(record, progress.elapsed)
     scenes = [s for s in config.scenes if any(p["scene"] == s for p in points)]
     record["plots"] = R.plot_all(points, scenes, output)
     record = report.json_safe(record)
@@ -977,12 +982,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         raised (its error is in the notes; the other studies' results are still written).
         A crash outside the studies propagates (Python exits with 1).
     """
-    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path("benchmarks/results"),
-                        help="output folder (default: benchmarks/results)")
-    parser.add_argument("--quick", action="store_true",
-                        help="ball and manipulator only, 3 time steps, one tolerance")
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, "ball and manipulator only, 3 time steps, one tolerance")
     record = run(args.output, args.quick)
     print(R.markdown_report(record))
     return 1 if record.get("failed_sections") else 0
