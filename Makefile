@@ -11,7 +11,7 @@ VENV ?= .venv
 TORCH_SPEC ?=
 BIN := $(VENV)/bin
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test docs bench lint clean
 
 # Install the package in editable mode with the given extras, once per extras set and pyproject.
 $(VENV)/.installed-%: pyproject.toml
@@ -31,12 +31,17 @@ test: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=10
 	$(BIN)/mdi-envs bench --quick
 
+# The docs site (MkDocs Material + mkdocstrings) into site/; strict: a broken link or reference
+# fails. Its generated pages read the committed JSON and parse the sources (nothing compiles).
+docs: $(VENV)/.installed-docs
+	NO_MKDOCS_2_WARNING=1 DISABLE_MKDOCS_2_WARNING=true $(BIN)/mkdocs build --strict
+
 bench: $(VENV)/.installed-bench
 	$(BIN)/mdi-envs bench
 
 lint: $(VENV)/.installed-dev
-	$(BIN)/ruff check mdi_envs optimal baselines tests benchmarks
+	$(BIN)/ruff check mdi_envs optimal baselines tests benchmarks docs
 	$(BIN)/mypy mdi_envs
 
 clean:
-	rm -rf $(VENV) results .pytest_cache .hypothesis
+	rm -rf $(VENV) results site .pytest_cache .hypothesis

@@ -117,9 +117,11 @@ class EpisodeRecord:
 
     Attributes:
         env_id, objective: the study. controller: its label. run: index of the controller's run
-        (a trained algorithm's seed). condition: the condition's label. seed: the reset seed.
-        is_success, elapsed_time [s], effort [N^2 m^2 s], solver_failures, compute_per_step
-        [s]: as ``baselines.compare.Episode``.
+            (a trained algorithm's seed). condition: the condition's label. seed: the reset
+            seed.
+        is_success, elapsed_time, effort, solver_failures, compute_per_step: as
+            ``baselines.compare.Episode`` (elapsed_time [s], effort [N^2 m^2 s],
+            compute_per_step [s]).
     """
 
     env_id: str

@@ -385,14 +385,17 @@ class BatchState:
     into them (``state.q[i] = ...``), never rebind them.
 
     Attributes:
-        q, u: (N, n) coordinates and velocities. tau: (N, m) last torques [N m].
-        brake: (N, k) last brake bounds (0 released, inf ideal). elapsed_steps: (N,) env
-        steps (whole numbers). effort: (N,) integral of sum(tau^2) [N^2 m^2 s]. potential:
-        (N,) Phi of the current state. terminated: (N,) 1.0 if the last step ended the episode
-        else 0.0. reward (N,), obs (N, NUM_OBSERVATIONS) float32, info (N, len(info_keys)):
-        the last step's outputs. impulses, physics: the stepper's outputs of the last physics
-        step (the impulses also warm-start the next step's solver for spatial contacts; zero
-        after a reset).
+        q, u: (N, n) coordinates and velocities.
+        tau: (N, m) last torques [N m].
+        brake: (N, k) last brake bounds (0 released, inf ideal).
+        elapsed_steps: (N,) env steps (whole numbers).
+        effort: (N,) integral of sum(tau^2) [N^2 m^2 s].
+        potential: (N,) Phi of the current state.
+        terminated: (N,) 1.0 if the last step ended the episode else 0.0.
+        reward, obs, info: the last step's outputs, (N,), (N, NUM_OBSERVATIONS) float32 and
+            (N, len(info_keys)).
+        impulses, physics: the stepper's outputs of the last physics step (the impulses also
+            warm-start the next step's solver for spatial contacts; zero after a reset).
     """
 
     q: FloatArray

@@ -163,7 +163,7 @@ def brake_schedule(engage_times: ArrayLike, release_times: ArrayLike = ()) -> Pi
     Raises:
         ValueError: the switches do not alternate engage/release.
 
-    Example:
+    Examples:
         >>> schedule = brake_schedule([0.0, 1.0], [0.5])
         >>> [float(schedule(t)[0]) for t in (0.0, 0.7, 1.2)]
         [inf, 0.0, inf]

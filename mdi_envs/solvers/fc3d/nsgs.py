@@ -142,8 +142,8 @@ def nsgs_kernel(
     Args:
         W: (n, n), n = 3 nc. q: (n,). mu: (nc,).
         r: (n,) starting point, overwritten by the iterate (modified in place).
-        max_iter, tol, local_max_iter, local_tol, armijo, max_backtracks, rho_scale,
-            relaxation, damping: see ``NSGSOptions``.
+        max_iter, tol, local_max_iter, local_tol: see ``NSGSOptions``.
+        armijo, max_backtracks, rho_scale, relaxation, damping: see ``NSGSOptions``.
 
     Returns:
         (code, sweeps, residual): code 0 converged, 1 sweep limit; the shared residual of r.

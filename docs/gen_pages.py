@@ -1,0 +1,330 @@
+"""Generate the environment, results and API pages of the docs site (run by mkdocs-gen-files).
+
+* ``envs/``: one page per id registered in the ``mdi_envs/`` namespace of Gymnasium's registry,
+  from the env class docstring (read statically by griffe), the registration, the shipped
+  optimal references for that id and its GIF (``docs/assets/<Name>.gif``).
+* ``results/``: tables (pandas ``to_markdown``) and the committed PNGs, read from the committed
+  JSON of ``benchmarks/results``, ``baselines/comparison``, ``baselines/robustness``,
+  ``optimal/references`` and ``optimal/search``.
+* ``api/``: one mkdocstrings page per public module of the documented packages.
+
+No kernel is compiled: env classes are never imported, only their source is parsed.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import griffe
+import gymnasium as gym
+import mkdocs_gen_files
+import pandas as pd
+
+import mdi_envs  # noqa: F401  (registers the ids)
+from baselines import robustness
+from optimal import available_references, load_reference
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "docs"))
+import headline  # noqa: E402  (docs/headline.py)
+
+NAMESPACE = "mdi_envs/"
+API_PACKAGES = ("mdi_envs.solvers", "mdi_envs.stepping", "mdi_envs.mechanics", "mdi_envs.envs",
+                "mdi_envs.tasks", "mdi_envs.rollout", "optimal", "baselines")
+LOADER = griffe.GriffeLoader(search_paths=[str(ROOT)], docstring_parser=griffe.Parser.google)
+
+
+def write(path: str, text: str) -> None:
+    """Write one generated page."""
+    with mkdocs_gen_files.open(path, "w") as handle:
+        handle.write(text)
+
+
+def copy_image(source: Path, folder: str) -> str:
+    """Copy a committed PNG into the site; returns its path relative to the page's folder."""
+    with mkdocs_gen_files.open(f"{folder}/img/{source.name}", "wb") as handle:
+        handle.write(source.read_bytes())
+    return f"img/{source.name}"
+
+
+def table(rows: list[dict[str, Any]], floatfmt: str = ".4g") -> str:
+    """A Markdown table of records (pandas ``to_markdown``)."""
+    return pd.DataFrame(rows).to_markdown(index=False, floatfmt=floatfmt)
+
+
+# --- environments -----------------------------------------------------------------------------
+
+def env_ids() -> list[str]:
+    """Every registered id of the ``mdi_envs/`` namespace, sorted."""
+    return sorted(i for i in gym.registry if i.startswith(NAMESPACE))
+
+
+def class_docstring(entry_point: str) -> str:
+    """The docstring of ``module:Class``, read from the source without importing it."""
+    module, name = entry_point.split(":")
+    obj = LOADER.load(module)[name]
+    return obj.docstring.value if obj.docstring else ""
+
+
+def env_gif(env_id: str) -> Path | None:
+    """``docs/assets/<Name>-vN.gif``, else the GIF of the same name at another version."""
+    name = env_id.removeprefix(NAMESPACE)
+    exact = ROOT / "docs" / "assets" / f"{name}.gif"
+    if exact.exists():
+        return exact
+    others = sorted((ROOT / "docs" / "assets").glob(f"{name.rsplit('-v', 1)[0]}-v*.gif"))
+    return others[-1] if others else None
+
+
+def references_for(env_id: str) -> list[dict[str, Any]]:
+    """The shipped optimal references whose metadata names ``env_id``."""
+    rows = []
+    for ref_name in available_references():
+        meta = load_reference(ref_name).metadata
+        if meta["env_id"] == env_id:
+            rows.append({"reference": f"`{ref_name}`", "objective": meta["cost_kind"],
+                         "t_f [s]": meta["final_time"], "cost": meta["cost"],
+                         "intervals N": meta["num_intervals"], "gym.make kwargs":
+                         f"`{meta['env_kwargs']}`" if meta["env_kwargs"] else ""})
+    return rows
+
+
+def env_page(env_id: str) -> str:
+    """The Markdown page of one env id."""
+    spec = gym.spec(env_id)
+    name = env_id.removeprefix(NAMESPACE)
+    lines = [f"# {name}", ""]
+    gif = env_gif(env_id)
+    if gif is not None:
+        lines += [f"![{name}](../assets/{gif.name})", ""]
+    lines += ["```python", "import gymnasium as gym", "import mdi_envs",
+              f'env = gym.make("{env_id}")', "```", "",
+              table([{"id": f"`{env_id}`", "entry point": f"`{spec.entry_point}`",
+                      "vector entry point": f"`{spec.vector_entry_point}`",
+                      "max_episode_steps": spec.max_episode_steps,
+                      "kwargs": f"`{spec.kwargs}`" if spec.kwargs else ""}]), ""]
+    refs = references_for(env_id)
+    if refs:
+        lines += ["## Optimal reference", "",
+                  "Loaded with `optimal.load_reference(NAME)` (from "
+                  "`optimal/references/NAME.json`); see [the references](../results/"
+                  "references.md).", "", table(refs), ""]
+    lines.append(class_docstring(str(spec.entry_point)))
+    return "\n".join(lines) + "\n"
+
+
+def env_pages() -> None:
+    """``envs/index.md`` (a table of every id) and one page per id."""
+    rows, nav = [], ["* [Environments](index.md)"]
+    for env_id in env_ids():
+        name = env_id.removeprefix(NAMESPACE)
+        write(f"envs/{name}.md", env_page(env_id))
+        nav.append(f"* [{name}]({name}.md)")
+        doc = class_docstring(str(gym.spec(env_id).entry_point))
+        first = doc.split("## Description", 1)[-1].strip().split("\n\n")[0].replace("\n", " ")
+        rows.append({"id": f"[`{env_id}`]({name}.md)", "description": first.split(". ")[0]})
+    write("envs/index.md", "# Environments\n\n`import mdi_envs` registers every id below "
+          "with Gymnasium. Each page is generated from the env class docstring.\n\n"
+          + table(rows) + "\n")
+    write("envs/SUMMARY.md", "\n".join(nav) + "\n")
+
+
+# --- results ----------------------------------------------------------------------------------
+
+def load(path: Path) -> Any:
+    """A committed JSON file."""
+    return json.loads(path.read_text())
+
+
+def machine_text(run: dict[str, Any]) -> str:
+    """One line on the machine and commit a benchmark ran on."""
+    machine = run.get("machine", {})
+    if not machine:
+        return ""
+    load = machine.get("load_average_at_start")
+    return (f"Run {machine.get('date', '?')[:10]} at commit `{machine.get('git_commit', '?')[:7]}`"
+            f" on {machine.get('cpu_count', '?')} cores ({machine.get('cpu_model', '?')}), load "
+            f"average at start {load[0] if load else '?'}.")
+
+
+BENCHMARKS = {  # file stem: (title, the command that writes it)
+    "solvers": ("LCP solvers", "mdi-envs bench solvers"),
+    "fc3d": ("Spatial friction (Siconos fc3d problems)", "mdi-envs bench fc3d"),
+    "engine": ("Engine: the Moreau-Jean step", "mdi-envs bench engine"),
+    "envs": ("Environments: env.step and vector envs", "mdi-envs bench envs"),
+    "work_precision": ("Work-precision against MuJoCo and the event-driven reference",
+                       "mdi-envs bench precision"),
+    "stress": ("Stress cases", "mdi-envs bench stress"),
+    "startup": ("Start-up", "mdi-envs bench startup"),
+    "vec_env_throughput": ("SB3 training throughput", "python -m benchmarks.vec_env_throughput"),
+    "before_after": ("Before/after speed comparison", "python -m benchmarks.before_after"),
+}
+
+
+def benchmark_page() -> None:
+    """``results/benchmarks.md``: the headline table, then per benchmark its targets and PNGs."""
+    folder = ROOT / "benchmarks" / "results"
+    lines = ["# Benchmark results", "",
+             "Generated from the committed JSON in `benchmarks/results/` (written by "
+             "`mdi-envs bench`; `make bench` runs them all). What each benchmark measures: "
+             "[the benchmarks guide](../guide/benchmarks.md).", ""]
+    headline = folder / "headline.json"
+    if headline.exists():
+        rows = [{k: r.get(k) for k in ("benchmark", "target", "measured", "comparison",
+                                       "threshold", "unit", "met", "note")}
+                for r in load(headline)["rows"]]
+        lines += ["## Headline", "", "Every target of the suite (`benchmarks/results/"
+                  "headline.json`).", "", table(rows), ""]
+    for stem, (title, command) in BENCHMARKS.items():
+        path = folder / f"{stem}.json"
+        if not path.exists():
+            continue
+        run = load(path)
+        lines += [f"## {title}", "", f"`{command}` writes `benchmarks/results/{stem}.json`. "
+                  + machine_text(run), ""]
+        targets = run.get("targets") or run.get("rows")
+        if stem == "stress":
+            targets = [{"family": c["family"], "case": c["name"], "passed": c["passed"]}
+                       for c in run["cases"]]
+        elif stem == "fc3d":
+            targets = [{"problem": p["name"], "n": p["n"], "contacts": p["contacts"],
+                        **{m: p[m].get("status") if isinstance(p[m], dict) else p[m]
+                           for m in run["solved_by_method"]}, "solved": p["solved"]}
+                       for p in run["problems"]]
+        elif stem == "vec_env_throughput":
+            targets = run["results"]
+        if targets:
+            flat = [{k: v for k, v in r.items() if not isinstance(v, (dict, list))}
+                    for r in targets]
+            lines += [table(flat), ""]
+        for png in sorted(folder.glob(f"{stem}*.png")) + sorted(
+                folder.glob("lemke_vs_quantecon.png") if stem == "solvers" else []):
+            lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    write("results/benchmarks.md", "\n".join(lines))
+
+
+def comparison_page() -> None:
+    """``results/comparison.md``: RL vs MPC vs optimal from ``baselines/comparison``."""
+    folder = ROOT / "baselines" / "comparison"
+    runs = headline.comparisons(folder)
+    lines = ["# RL vs MPC vs optimal", "",
+             "Generated from `baselines/comparison/compare_*.json` (written by "
+             "`mdi-envs compare all --output baselines/comparison`). Each controller plays 20 "
+             "perturbed starts per run; success is the fraction reaching the goal, ratios are "
+             "time (or effort) over the optimal reference's, over the successes; IQM and 95 % "
+             "stratified-bootstrap CI over runs (rliable). The method: "
+             "[the baselines guide](../guide/baselines.md).", "",
+             headline.headline_frame(runs).to_markdown(index=False), ""]
+    for png in sorted(folder.glob("*.png")):
+        lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    write("results/comparison.md", "\n".join(lines))
+
+
+def robustness_page() -> None:
+    """``results/robustness.md``: success and ratio under perturbations and model mismatch."""
+    folder = ROOT / "baselines" / "robustness"
+    studies = [load(p) for p in sorted(folder.glob("robustness_*.json"))]
+    lines = ["# Robustness", "",
+             "Generated from `baselines/robustness/robustness_*.json` (written by "
+             "`python -m baselines.robustness all --output baselines/robustness`; every episode "
+             "is in `episodes.jsonl`). Each cell: success over 20 starts per run, and in "
+             "brackets the time (or effort) over the optimum, over the successes.", "",
+             robustness.markdown_table(studies), ""]
+    for png in sorted(folder.glob("*.png")):
+        lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    write("results/robustness.md", "\n".join(lines))
+
+
+def references_page() -> None:
+    """``results/references.md``: the shipped optimal references and their searches."""
+    rows, refine = [], []
+    for name in available_references():
+        meta = load_reference(name).metadata
+        replay = {r["substeps"]: r for r in meta["replay"]}
+        rows.append({"reference": name, "env id": meta["env_id"], "objective": meta["cost_kind"],
+                     "t_f [s]": meta["final_time"], "cost": meta["cost"],
+                     "N": meta["num_intervals"], "residual": meta["residual"],
+                     "replay error at h": replay[1]["state_error"],
+                     "reaches goal at h": replay[1]["reaches_goal"],
+                     "replay error at h/10": replay.get(10, {}).get("state_error"),
+                     "commit": meta["commit"][:7]})
+    lines = ["# Optimal references", "",
+             "Generated from `optimal/references/*.json` (the metadata of each shipped "
+             "reference, read by `optimal.load_reference`) and `optimal/search/*.json` (the "
+             "global search and mesh refinement that produced it). Method: "
+             "[the optimal-control guide](../guide/optimal.md).", "",
+             "## Shipped references", "", table(rows, floatfmt=".6g"), "",
+             "The replay plays the reference's controls open loop through the simulator at the "
+             "reference's step h and at h/10 (state error at t_f; the references are optima of "
+             "the h-discrete system).", ""]
+    for path in sorted((ROOT / "optimal" / "search").glob("*_search.json")):
+        run = load(path)
+        name = path.stem.removesuffix("_search")
+        search = run["search"]
+        lines += [f"## Search: {name}", "",
+                  f"`mdi-envs optimize {name} --starts K --refine F1,F2,...` writes "
+                  f"`{path.name}`: {search['starts']} starts, {search['solves']} fixed-pattern "
+                  f"solves, best from start \"{search['best_start']}\". The 10 best distinct "
+                  "optima: " + ", ".join(f"{c:.4f}" for c in search["distinct_optima"][:10])
+                  + ".", ""]
+        refine = [{"N": lv["num_intervals"], "cost": lv["cost"],
+                   "t_f [s]": lv["final_time"], "converged": lv["converged"],
+                   "shipped": i == run["shipped_level"]}
+                  for i, lv in enumerate(run["refinement"]["levels"])]
+        lines += ["Mesh refinement (each level starts from the coarser one):", "",
+                  table(refine, floatfmt=".6g"), ""]
+        png = path.with_suffix(".png")
+        if png.exists():
+            lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    write("results/references.md", "\n".join(lines))
+
+
+def results_pages() -> None:
+    """Every results page and its nav entries."""
+    write("results/index.md", "# Results\n\nEvery table on these pages is generated at build "
+          "time from the committed JSON; every figure is a committed PNG.\n\n"
+          "* [RL vs MPC vs optimal](comparison.md)\n* [Robustness](robustness.md)\n"
+          "* [Optimal references](references.md)\n* [Benchmarks](benchmarks.md)\n")
+    comparison_page()
+    robustness_page()
+    references_page()
+    benchmark_page()
+    write("results/SUMMARY.md", "* [Results](index.md)\n* [RL vs MPC vs optimal](comparison.md)\n"
+          "* [Robustness](robustness.md)\n* [Optimal references](references.md)\n"
+          "* [Benchmarks](benchmarks.md)\n")
+
+
+# --- API reference ----------------------------------------------------------------------------
+
+def public_modules(package: str) -> Iterator[str]:
+    """``package`` and its submodules whose dotted path has no ``_``-prefixed part."""
+    root = LOADER.load(package)
+    stack = [root]
+    while stack:
+        module = stack.pop()
+        if any(part.startswith("_") for part in module.path.split(".")):
+            continue
+        yield module.path
+        stack.extend(m for m in module.modules.values() if not m.is_alias)
+
+
+def api_pages() -> None:
+    """One mkdocstrings page per public module."""
+    modules = sorted(m for package in API_PACKAGES for m in public_modules(package))
+    for module in modules:
+        write(f"api/{module}.md", f"# `{module}`\n\n::: {module}\n    options:\n"
+              "      show_root_heading: false\n      show_submodules: false\n")
+    write("api/index.md", "# API reference\n\nGenerated from the docstrings (griffe reads the "
+          "source; nothing is imported).\n\n" + "\n".join(f"* [`{m}`]({m}.md)" for m in modules)
+          + "\n")
+    write("api/SUMMARY.md", "* [API reference](index.md)\n"
+          + "\n".join(f"* [{m}]({m}.md)" for m in modules) + "\n")
+
+
+env_pages()
+results_pages()
+api_pages()

@@ -1,0 +1,118 @@
+"""The headline results (RL vs MPC vs optimal) from the committed comparison JSON.
+
+``python docs/headline.py`` prints the README's results table and writes its plot,
+``docs/assets/headline.png``; ``docs/gen_pages.py`` uses the same table on the results page.
+The numbers come from ``baselines/comparison/compare_*.json`` (``mdi-envs compare all``).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parent.parent
+COMPARISON_DIR = ROOT / "baselines" / "comparison"
+PLOT = ROOT / "docs" / "assets" / "headline.png"
+
+
+def comparisons(folder: Path = COMPARISON_DIR) -> list[dict[str, Any]]:
+    """Every committed ``compare_*.json``, sorted by env and objective."""
+    return [json.loads(p.read_text()) for p in sorted(folder.glob("compare_*.json"))]
+
+
+def _interval(estimate: dict[str, Any], percent: bool) -> str:
+    """"IQM [low, high]", the value alone without a CI, or "-" without any score."""
+    if estimate["iqm"] is None:
+        return "-"
+    show = (lambda v: f"{100 * v:.0f} %") if percent else (lambda v: f"{v:.2f}")
+    some = f" ({estimate['n']} of {estimate['n'] + estimate['missing']} runs)" \
+        if estimate.get("missing") else ""
+    if estimate.get("ci") is None:
+        return show(estimate["iqm"]) + some
+    low, high = estimate["ci"]
+    return f"{show(estimate['iqm'])} [{show(low)}, {show(high)}]{some}"
+
+
+def headline_frame(runs: list[dict[str, Any]]) -> pd.DataFrame:
+    """One row per env x objective x controller: success and ratio to the optimum, IQM [CI]."""
+    rows = []
+    for run in runs:
+        objective = run["task"]
+        for row in run["controllers"]:
+            aggregate = row["aggregate"]
+            rows.append({
+                "env": run["env_id"].removeprefix("mdi_envs/"),
+                "objective": objective,
+                "controller": row["label"],
+                "runs": len(row["runs"]),
+                "success": _interval(aggregate["success_rate"], percent=True),
+                "time or effort / optimal": _interval(aggregate[f"{objective}_ratio"],
+                                                      percent=False),
+            })
+    return pd.DataFrame(rows)
+
+
+def headline_plot(runs: list[dict[str, Any]], path: Path = PLOT) -> Path:
+    """Success (bars) and ratio to the optimum (dots) per controller, one panel per task."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(runs), figsize=(4.2 * len(runs), 3.4), squeeze=False)
+    for ax, run in zip(axes[0], runs, strict=True):
+        labels = [row["label"].replace(" (shrinking horizon)", "").replace(" (open loop)",
+                                                                           "\n(open loop)")
+                  for row in run["controllers"]]
+        success = [row["aggregate"]["success_rate"] for row in run["controllers"]]
+        ratio = [row["aggregate"][f"{run['task']}_ratio"] for row in run["controllers"]]
+        x = range(len(labels))
+        ax.bar(x, [s["iqm"] for s in success], color="tab:green", alpha=0.8,
+               yerr=_errors(success), capsize=3, label="success (IQM, 95 % CI)")
+        ax.set_ylim(0, 1.05)
+        ax.set_xticks(list(x), labels, fontsize=7)
+        ax.set_title(f"{run['env_id'].removeprefix('mdi_envs/')}, {run['task']}", fontsize=9)
+        twin = ax.twinx()
+        shown = [i for i, r in enumerate(ratio) if r["iqm"] is not None]
+        twin.errorbar(shown, [ratio[i]["iqm"] for i in shown],
+                      yerr=_errors([ratio[i] for i in shown]), fmt="o", color="black",
+                      capsize=3, label="time or effort / optimal")
+        twin.axhline(1.0, color="gray", lw=0.8, ls=":")
+        twin.set_ylim(0, 2.2)
+        if ax is axes[0][0]:
+            ax.set_ylabel("success rate")
+            ax.legend(loc="lower left", fontsize=7)
+        if ax is axes[0][-1]:
+            twin.set_ylabel("time or effort / optimal")
+            twin.legend(loc="lower right", fontsize=7)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def _errors(estimates: list[dict[str, Any]]) -> list[list[float]]:
+    """Asymmetric error bars (2, k) from IQM and CI (zero without a CI)."""
+    low, high = [], []
+    for e in estimates:
+        ci = e.get("ci") or [e["iqm"], e["iqm"]]
+        low.append(e["iqm"] - ci[0])
+        high.append(ci[1] - e["iqm"])
+    return [low, high]
+
+
+def main() -> int:
+    """Print the README table and write the plot."""
+    runs = comparisons()
+    print(headline_frame(runs).to_markdown(index=False))
+    print(f"wrote {headline_plot(runs).relative_to(ROOT)}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

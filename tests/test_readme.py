@@ -1,0 +1,45 @@
+"""The README's example runs, and its results table is the one generated from committed JSON."""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+README = ROOT / "README.md"
+
+
+def _section(title: str) -> str:
+    """The README text under ``## title`` up to the next ``## ``."""
+    text = README.read_text()
+    return text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0]
+
+
+def test_readme_is_short() -> None:
+    assert len(README.read_text().splitlines()) <= 200
+
+
+def test_results_table_is_generated_from_the_comparison_json() -> None:
+    sys.path.insert(0, str(ROOT / "docs"))
+    try:
+        import headline
+    finally:
+        sys.path.remove(str(ROOT / "docs"))
+    table = headline.headline_frame(headline.comparisons()).to_markdown(index=False)
+    assert table in _section("Results")
+    assert len(table.splitlines()) > 2
+
+
+@pytest.mark.slow
+def test_example_runs(capsys: pytest.CaptureFixture[str]) -> None:
+    """The example block with a tiny training budget (one PPO rollout of 64 steps)."""
+    code = re.search(r"```python\n(.*?)```", _section("Example"), re.S).group(1)
+    assert "total_timesteps=200_000" in code
+    code = code.replace("total_timesteps=200_000", "total_timesteps=64").replace(
+        'PPO("MlpPolicy", env, seed=0)', 'PPO("MlpPolicy", env, seed=0, n_steps=64, batch_size=64)')
+    exec(compile(code, str(README), "exec"), {})
+    printed = capsys.readouterr().out
+    assert re.search(r"success (True|False), time \d+\.\d\d s, optimum \d\.\d{3} s", printed)
