@@ -34,7 +34,7 @@ import headline  # noqa: E402  (docs/headline.py)
 
 NAMESPACE = "mdi_envs/"
 API_PACKAGES = ("mdi_envs.solvers", "mdi_envs.stepping", "mdi_envs.mechanics", "mdi_envs.envs",
-                "mdi_envs.tasks", "mdi_envs.rollout", "optimal", "baselines")
+                "mdi_envs.maneuvers", "mdi_envs.rollout", "optimal", "baselines")
 LOADER = griffe.GriffeLoader(search_paths=[str(ROOT)], docstring_parser=griffe.Parser.google)
 
 
