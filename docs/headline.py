@@ -41,7 +41,7 @@ def headline_frame(runs: list[dict[str, Any]]) -> pd.DataFrame:
     """One row per env x objective x controller: success and ratio to the optimum, IQM [CI]."""
     rows = []
     for run in runs:
-        objective = run["task"]
+        objective = run["objective"]
         for row in run["controllers"]:
             aggregate = row["aggregate"]
             rows.append({
@@ -57,7 +57,7 @@ def headline_frame(runs: list[dict[str, Any]]) -> pd.DataFrame:
 
 
 def headline_plot(runs: list[dict[str, Any]], path: Path = PLOT) -> Path:
-    """Success (bars) and ratio to the optimum (dots) per controller, one panel per task."""
+    """Success (bars) and ratio to the optimum (dots) per controller, one panel per objective."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -69,13 +69,13 @@ def headline_plot(runs: list[dict[str, Any]], path: Path = PLOT) -> Path:
                                                                            "\n(open loop)")
                   for row in run["controllers"]]
         success = [row["aggregate"]["success_rate"] for row in run["controllers"]]
-        ratio = [row["aggregate"][f"{run['task']}_ratio"] for row in run["controllers"]]
+        ratio = [row["aggregate"][f"{run['objective']}_ratio"] for row in run["controllers"]]
         x = range(len(labels))
         ax.bar(x, [s["iqm"] for s in success], color="tab:green", alpha=0.8,
                yerr=_errors(success), capsize=3, label="success (IQM, 95 % CI)")
         ax.set_ylim(0, 1.05)
         ax.set_xticks(list(x), labels, fontsize=7)
-        ax.set_title(f"{run['env_id'].removeprefix('mdi_envs/')}, {run['task']}", fontsize=9)
+        ax.set_title(f"{run['env_id'].removeprefix('mdi_envs/')}, {run['objective']}", fontsize=9)
         twin = ax.twinx()
         shown = [i for i, r in enumerate(ratio) if r["iqm"] is not None]
         twin.errorbar(shown, [ratio[i]["iqm"] for i in shown],
