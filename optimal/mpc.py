@@ -63,7 +63,7 @@ GRIDS = ("env", "free")
 """The grids a time-optimal plan is on (the module docstring)."""
 
 GRID_OF_REFERENCE = {"manipulator_time": "env", "diff_drive_time": "free"}
-"""The grid of each time-optimal reference's MPC, by measurement (optimal/README.md). The
+"""The grid of each time-optimal reference's MPC, chosen by measurement. The
 manipulator on the free grid lost 9 % of the optimal time in closed loop at perturbation 0.1
 (its plans' last intervals, 11 ms long, held for 35.5 ms, overshot the goal) and reached
 1.10x; on the env's grid 0.985x. The robot on the env's grid spent over 4 min on its first
@@ -86,7 +86,7 @@ the goal within this fraction of the maneuver's success tolerances."""
 NLP_CACHE_SIZE = 400
 """Fixed-pattern NLPs a controller keeps (least recently used dropped). Each takes about 11 MB
 at 120 intervals (the 20-start manipulator evaluation's process grew to 4.9 GB), a robot one
-about 30 MB once solved (so up to ~12 GB; optimal/README.md, "Memory under a mismatch").
+about 30 MB once solved (so up to ~12 GB).
 Building one costs 0.5-0.8 s at 120 intervals and its first solve another 0.2 s (CasADi's
 expand); a warm-started re-solve of a kept one about 0.1 s. Episodes from nearby starts visit
 the same (intervals, pattern) keys, so from the second episode on most steps reuse an NLP."""
