@@ -1,8 +1,8 @@
-"""``mdi-envs train``, ``compare`` and ``sweep``: the subcommands of the baselines.
+"""The baselines' subcommands: ``simulate``, ``demo``, ``train``, ``compare`` and ``sweep``.
 
-Wiring (in ``mdi_envs/cli.py``): ``from baselines.cli import add_train_parser`` and call
-``add_train_parser(commands)`` on the subparsers (likewise ``add_compare_parser``,
-``add_sweep_parser``); each parser's handler is its ``run_*`` function.
+Each ``add_*_parser`` is registered in ``pyproject.toml`` as a ``mdi_envs.commands`` entry
+point (the plug-in interface is in ``mdi_envs/cli.py``); each parser's handler is its ``run_*``
+function.
 Example: ``mdi-envs train mdi_envs/DiffDriveRobot-v0 PPO --objective effort --output
 results/baselines`` (5 x 10^6 steps; the budget and settings are in
 ``baselines/hyperparams/*.yml``, rl-zoo3's format) shows SB3's progress bar on a terminal and
@@ -235,7 +235,108 @@ def run_sweep(args: argparse.Namespace) -> int:
     return 1 if outcome["failed"] else 0
 
 
+def add_simulate_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``simulate`` subcommand to an argparse subparsers object; returns its parser."""
+    parser = subparsers.add_parser(
+        "simulate",
+        help="play one episode of an environment (random, a saved policy, open-loop actions or "
+        "an optimal reference) and optionally save a GIF/MP4",
+        description="Run one episode of ENV_ID and print its length, return, success, elapsed "
+        "time and effort. POLICY is 'random', a trained SB3 model (.zip, with --algo), a file "
+        "of normalised actions (.npy or .csv, one row per step) or 'reference:NAME' (the "
+        "open-loop controls of a shipped optimal reference, at its own time step).",
+    )
+    parser.add_argument("env_id", help="e.g. mdi_envs/BlockableManipulator-v0")
+    parser.add_argument("--policy", default="random", help="see above (default: random)")
+    parser.add_argument("--algo", default="PPO",
+                        help="algorithm of a .zip policy (PPO, SAC, HybridPPO)")
+    parser.add_argument("--seed", type=int, default=0, help="reset seed")
+    parser.add_argument("--steps", type=int, default=None, help="stop after this many steps")
+    parser.add_argument("--save", type=Path, default=None, help="write a .gif or .mp4")
+    parser.add_argument("--human", action="store_true", help="show a window while playing")
+    parser.add_argument("--env-arg", action="append", default=[], metavar="KEY=VALUE",
+                        type=_env_argument,
+                        help="environment argument, e.g. objective=effort (repeatable)")
+    parser.set_defaults(handler=run_simulate)
+    return parser
+
+
+def run_simulate(args: argparse.Namespace) -> int:
+    """Handler of ``simulate``: plays the episode, prints its outcome; returns 0."""
+    from mdi_envs.rendering import save_animation
+    from mdi_envs.rollout import load_actions, open_loop_policy, rollout
+
+    env_kwargs = dict(args.env_arg)
+    policy: Any = args.policy
+    if policy.startswith("reference:"):
+        from optimal import load_reference
+        from optimal.replay import env_actions, env_options
+
+        reference = load_reference(policy.partition(":")[2])
+        env_kwargs = {**env_options(reference), **env_kwargs}
+        policy = open_loop_policy(env_actions(reference))
+    elif policy.endswith(".zip"):
+        from baselines.train import load_trained
+
+        model = load_trained(args.algo, policy)
+        policy = lambda obs: model.predict(obs, deterministic=True)[0]  # noqa: E731
+    elif policy != "random":
+        policy = open_loop_policy(load_actions(Path(policy)))
+    result = rollout(args.env_id, policy, seed=args.seed, max_steps=args.steps,
+                     record=args.save is not None, render_mode="human" if args.human else None,
+                     **env_kwargs)  # fmt: skip
+    info = result.last_info
+    end = "terminated" if result.terminated else "truncated" if result.truncated else "stopped"
+    print(f"{args.env_id}: {result.num_steps} steps ({end}), return {result.total_reward:.4f}, "
+          f"success {info.get('is_success')}, elapsed {info.get('elapsed_time', 0.0):.3f} s, "
+          f"effort {info.get('effort', 0.0):.4g} N^2 m^2 s")  # fmt: skip
+    if args.save is not None:
+        path = save_animation(result.frames, args.save, fps=30)
+        print(f"wrote {path}")
+    return 0
+
+
+def _env_argument(text: str) -> tuple[str, Any]:
+    """KEY=VALUE with VALUE read as a Python literal when it is one (numbers, booleans)."""
+    import ast
+
+    key, separator, value = text.partition("=")
+    if not separator or not key:
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
+    try:
+        return key, ast.literal_eval(value)
+    except (ValueError, SyntaxError):
+        return key, value
+
+
+def add_demo_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``demo`` subcommand to an argparse subparsers object; returns its parser."""
+    parser = subparsers.add_parser(
+        "demo",
+        help="the environments, the optimal references replayed (GIFs) and the RL vs MPC vs "
+        "optimal comparison with trained policies played live",
+        description="Make every environment with gym.make and show its spaces; replay every "
+        "shipped optimal reference open loop through its env (a GIF each); print the committed "
+        "RL vs MPC vs optimal table and play the best-evaluated trained policy of each "
+        "algorithm from the nominal start beside the reference (a GIF per env and objective). "
+        "Needs the rl and render extras. About a minute on a warm kernel cache.",
+    )
+    parser.add_argument("--output", type=Path, default=Path("results/demo"),
+                        help="folder for the GIFs")
+    parser.set_defaults(handler=run_demo)
+    return parser
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    """Handler of ``demo``: runs ``baselines.demo.run_demo``, prints the written paths."""
+    from baselines.demo import run_demo as demo
+
+    for path in demo(args.output):
+        print(f"wrote {path}")
+    return 0
+
+
 __all__ = [
-    "add_compare_parser", "add_sweep_parser", "add_train_parser", "run_compare", "run_sweep",
-    "run_train",
+    "add_compare_parser", "add_demo_parser", "add_simulate_parser", "add_sweep_parser",
+    "add_train_parser", "run_compare", "run_demo", "run_simulate", "run_sweep", "run_train",
 ]

@@ -6,7 +6,8 @@ folder holds into ``headline.json`` and ``headline.md``. Without NAME every benc
 the order of ``BENCHMARKS``. The exit code is non-zero when a benchmark crashes or a stress case
 fails (``--quick`` runs inside ``make test`` and so checks the stress criteria on every commit).
 
-Wiring (in ``mdi_envs/cli.py``): ``add_bench_parser(commands)``; its handler is ``run_bench``.
+Registered in ``pyproject.toml`` as the ``mdi_envs.commands`` entry point ``bench`` (the
+plug-in interface is in ``mdi_envs/cli.py``); its handler is ``run_bench``.
 """
 
 from __future__ import annotations

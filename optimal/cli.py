@@ -1,7 +1,7 @@
 """``mdi-envs optimize NAME``: recompute one reference with progress output.
 
-Wiring (in ``mdi_envs/cli.py``): ``from optimal.cli import add_optimize_parser`` and call
-``add_optimize_parser(commands)`` on the subparsers; the parser's handler is ``run_optimize``.
+Registered in ``pyproject.toml`` as the ``mdi_envs.commands`` entry point ``optimize`` (the
+plug-in interface is in ``mdi_envs/cli.py``); the parser's handler is ``run_optimize``.
 Example: ``mdi-envs optimize manipulator_time --output results/optimal`` (about a minute)
 prints one line per continuation stage and per replay, writes ``NAME.npz``/``NAME.json`` and
 the PNG figures into ``--output`` and, with ``--install``, into the package's references.

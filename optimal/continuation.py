@@ -67,6 +67,13 @@ class Schedule:
             raise ValueError("penalties and relaxations must be nonempty and of equal length")
 
 
+SCHEDULES = {"diff_drive_time": Schedule(mu_strategy="monotone"),
+             "diff_drive_effort": Schedule(mu_strategy="monotone")}
+"""Per-problem continuation schedules (others: ``Schedule()``). The robot's first stage, from
+the naive guess far from complementarity, takes 5-20x fewer IPOPT iterations with the monotone
+barrier update."""
+
+
 @dataclass(frozen=True)
 class StageRecord:
     """One stage of the continuation.
@@ -237,5 +244,5 @@ def _fix_active_sets(transcription: Transcription, values: Callable[[Any], Any])
 
 __all__ = [
     "BOUND_RELAXATION", "POLISH_BOUND_RELAXATION", "POLISH_RELAXATION", "ContinuationResult",
-    "Schedule", "StageRecord", "set_solver", "solve_continuation",
+    "SCHEDULES", "Schedule", "StageRecord", "set_solver", "solve_continuation",
 ]

@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from optimal.continuation import Schedule, solve_continuation
+from optimal.continuation import SCHEDULES, Schedule, solve_continuation
 from optimal.mode_search import LocalSearch, ModeSolve, improve_modes, solve_with_modes
 from optimal.modes import ModePattern
 from optimal.problems import make_problem
@@ -248,14 +248,13 @@ def global_search(name: str, num_starts: int, num_intervals: int | None = None,
 
     Args:
         name: the problem. num_starts: how many (``make_starts``). num_intervals: N.
-        schedule: the continuation's (default: ``optimal.solve.SCHEDULES`` or ``Schedule()``).
+        schedule: the continuation's (default: the problem's in ``SCHEDULES``, else
+            ``Schedule()``).
         seed: of the random starts. workers: processes (default: one per core; 1 runs in this
             process). max_shift: of the switch moves. starts: explicit starts instead.
         progress: called with each finished start. show_bar: a tqdm bar over the starts.
     """
     from tqdm import tqdm
-
-    from optimal.solve import SCHEDULES
 
     problem = make_problem(name, num_intervals)
     schedule = schedule or SCHEDULES.get(name)

@@ -50,13 +50,12 @@ import numpy as np
 from mdi_envs._types import FloatArray
 from mdi_envs.angles import wrap_angle
 from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
-from optimal.continuation import Schedule, solve_continuation
+from optimal.continuation import SCHEDULES, Schedule, solve_continuation
 from optimal.mode_search import ModeSolve, solve_with_modes
 from optimal.modes import ModePattern
 from optimal.problems import make_problem
 from optimal.references import Reference
 from optimal.solution import SLIP_TOLERANCE, read_modes, read_solution, values_at
-from optimal.solve import SCHEDULES
 from optimal.transcription import GUESS_IMPULSES, Transcription, regridded_impulses
 
 GRIDS = ("env", "free")

@@ -17,7 +17,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from optimal.continuation import Schedule, solve_continuation
+from optimal.continuation import SCHEDULES, Schedule, solve_continuation
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
 from optimal.replay import replay
@@ -31,12 +31,6 @@ GUESS_TIME_FACTORS = {"manipulator_time": (0.66, 0.88, 1.0, 1.1, 1.32)}
 """Multi-start: the naive guess is repeated with t_f scaled by these factors and the best
 converged solution kept (the manipulator's problem has many local optima). Problems not listed
 start once."""
-
-SCHEDULES = {"diff_drive_time": Schedule(mu_strategy="monotone"),
-             "diff_drive_effort": Schedule(mu_strategy="monotone")}
-"""Per-problem continuation schedules (others: ``Schedule()``). The robot's first stage, from
-the naive guess far from complementarity, takes 5-20x fewer IPOPT iterations with the monotone
-barrier update."""
 
 SHIPPED_LEVEL_CHANGE = 0.005
 """``search_reference`` ships the coarsest refinement level whose cost changes by less than

@@ -1,22 +1,29 @@
-"""Tests of the ``mdi-envs`` command line (``mdi_envs/cli.py``)."""
+"""Tests of the ``mdi-envs`` command line: the core subcommands and the plug-in mechanism."""
 
 from __future__ import annotations
 
+import argparse
+import subprocess
+import sys
+from importlib.metadata import EntryPoint
 from pathlib import Path
 
-import numpy as np
 import pytest
 from peer_data import peer_params
 
-from mdi_envs.cli import main
+from mdi_envs import cli
+from mdi_envs.cli import COMMAND_GROUP, _build_parser, main, plugin_commands
 
 
-def test_help_lists_the_commands(capsys: pytest.CaptureFixture[str]) -> None:
-    with pytest.raises(SystemExit) as exit_info:
-        main(["--help"])
-    assert exit_info.value.code == 0
-    out = capsys.readouterr().out
-    assert "demo" in out and "solve" in out
+def test_help_lists_every_plugin_without_importing_one() -> None:
+    code = ("import sys\nfrom mdi_envs.cli import main\ntry:\n    main(['--help'])\n"
+            "except SystemExit:\n    pass\nloaded = sorted({name.partition('.')[0] for name in "
+            "sys.modules} & {'optimal', 'baselines', 'benchmarks'})\nprint('loaded', loaded)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout  # fmt: skip
+    assert out.splitlines()[-1] == "loaded []"
+    for name in (*plugin_commands(), "solve", "compile"):
+        assert f"    {name} " in out
 
 
 def test_no_command_prints_help(capsys: pytest.CaptureFixture[str]) -> None:
@@ -24,16 +31,33 @@ def test_no_command_prints_help(capsys: pytest.CaptureFixture[str]) -> None:
     assert "usage: mdi-envs" in capsys.readouterr().out
 
 
-def test_demo_writes_its_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["demo", "--output", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
-    assert "CONVERGED" in out
-    assert "max deviation from the event-driven reference" in out
-    assert "optimal reference manipulator_time replayed" in out and "success True" in out
-    assert "success False" not in out
-    for name in ("lcp_methods_time.png", "lcp_complementarity.png",
-                 "manipulator_brake_schedule.png", "manipulator_time.gif"):
-        assert (tmp_path / name).stat().st_size > 1000
+def test_every_registered_plugin_adds_its_subcommand() -> None:
+    plugins = plugin_commands()
+    assert {"optimize", "simulate", "demo", "train", "sweep", "compare", "bench"} <= set(plugins)
+    for name in plugins:
+        parser = _build_parser(name)
+        subcommands = next(action for action in parser._actions
+                           if isinstance(action, argparse._SubParsersAction))
+        assert callable(subcommands.choices[name].get_default("handler")), name
+
+
+@pytest.mark.parametrize(("value", "message"), [
+    ("no_such_module_xyz:add", "its plug-in no_such_module_xyz:add cannot be imported"),
+    ("argparse:ArgumentParser", "did not add a subcommand named 'broken'"),
+])
+def test_a_broken_plugin_is_reported(monkeypatch: pytest.MonkeyPatch, value: str,
+                                     message: str) -> None:
+    broken = EntryPoint(name="broken", value=value, group=COMMAND_GROUP)
+    monkeypatch.setattr(cli, "entry_points", lambda group: [broken])
+    with pytest.raises((SystemExit, RuntimeError, TypeError), match=message):
+        main(["broken"])
+
+
+def test_a_plugin_named_like_a_core_command_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    clash = EntryPoint(name="solve", value="optimal.cli:add_optimize_parser", group=COMMAND_GROUP)
+    monkeypatch.setattr(cli, "entry_points", lambda group: [clash])
+    with pytest.raises(RuntimeError, match="named like the core subcommand 'solve'"):
+        main(["--help"])
 
 
 def test_solve_reads_a_siconos_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -60,27 +84,3 @@ def test_solve_reports_a_ray_with_exit_code(tmp_path: Path) -> None:
     path = tmp_path / "infeasible.dat"
     path.write_text("2\n0\n2\n2\n2 2\n-1 0\n0 -1\n-1 -1\n")
     assert main(["solve", str(path)]) == 1
-
-
-def test_simulate_replays_the_optimal_reference_to_success(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    gif = tmp_path / "ref.gif"
-    assert main(["simulate", "mdi_envs/BlockableManipulator-v0", "--policy",
-                 "reference:manipulator_time", "--save", str(gif)]) == 0
-    out = capsys.readouterr().out
-    assert "(terminated)" in out and "success True" in out
-    assert gif.stat().st_size > 0
-
-
-def test_simulate_open_loop_file_and_env_args(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    actions = tmp_path / "actions.csv"
-    np.savetxt(actions, np.tile([0.5, 0.5], (10, 1)), delimiter=",")
-    assert main(["simulate", "mdi_envs/DiffDriveRobot-v0", "--policy", str(actions),
-                 "--env-arg", "objective=effort", "--steps", "10"]) == 0
-    out = capsys.readouterr().out
-    assert "10 steps (stopped)" in out and "elapsed 0.500 s" in out
-    with pytest.raises(ValueError, match=".npy or .csv"):
-        main(["simulate", "mdi_envs/DiffDriveRobot-v0", "--policy", str(tmp_path / "a.txt")])

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numba
 import numpy as np
@@ -26,12 +26,10 @@ from mdi_envs._kernel_cache import define, freeze
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers.status import SolverStatus
 from mdi_envs.stepping._kernel import INFO_STATUS
-from mdi_envs.stepping.moreau_jean import (
-    _INPUT_PROBLEMS,
-    _STATUS_OF_CODE,
-    MoreauJeanStepper,
-    _screen_inputs,
-)
+from mdi_envs.stepping._screen import INPUT_PROBLEMS, STATUS_OF_CODE, screen_inputs
+
+if TYPE_CHECKING:  # the stepper builds an InPlaceStepper (MoreauJeanStepper.in_place)
+    from mdi_envs.stepping.moreau_jean import MoreauJeanStepper
 
 _KERNELS: dict[tuple[Any, type], Any] = {}
 
@@ -52,7 +50,7 @@ def _buffer_layout(stepper: MoreauJeanStepper) -> list[tuple[str, int]]:
 def _make_kernel(stepper: MoreauJeanStepper) -> Any:
     """Compile ``step_in_place(buffer)`` around ``stepper.compiled_step``.
 
-    It raises ValueError with the message of ``_INPUT_PROBLEMS`` before touching the state
+    It raises ValueError with the message of ``INPUT_PROBLEMS`` before touching the state
     when the screen finds a problem.
     """
     record = stepper.compiled_step_batch[1]
@@ -66,7 +64,7 @@ def _make_kernel(stepper: MoreauJeanStepper) -> Any:
     lines += [
         "    problem = screen(q, u, tau, brake)",
         *(f"    if problem == {code}:\n        raise ValueError({message!r})"
-          for code, message in enumerate(_INPUT_PROBLEMS) if code > 0),
+          for code, message in enumerate(INPUT_PROBLEMS) if code > 0),
         "    step(q, u, tau, brake, dt, p, q_next, u_next, impulses, info,",
         "         (float_scratch, int_scratch.view(np.int64)))",
         f"    for i in range({stepper.num_dofs}):",
@@ -74,7 +72,7 @@ def _make_kernel(stepper: MoreauJeanStepper) -> Any:
         "        u[i] = u_next[i]",
     ]
     namespace: dict[str, Any] = {"Record": type(record), "step": stepper.compiled_step,
-                                 "screen": _screen_inputs, "np": np}
+                                 "screen": screen_inputs, "np": np}
     define("\n".join(lines), namespace)
     return borrowing_njit(namespace["step_in_place"])
 
@@ -131,7 +129,7 @@ class InPlaceStepper:
     @property
     def status(self) -> SolverStatus:
         """The last step's solve status (CONVERGED when nothing had to be solved)."""
-        return _STATUS_OF_CODE[int(self._info[INFO_STATUS])]
+        return STATUS_OF_CODE[int(self._info[INFO_STATUS])]
 
     @property
     def diagnostics(self) -> FloatArray:

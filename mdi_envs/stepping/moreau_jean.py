@@ -9,12 +9,10 @@ from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
-from numba import njit
 
-from mdi_envs._borrowing import REFERENCE_COUNTED
 from mdi_envs._kernel_cache import freeze
 from mdi_envs._types import FloatArray
 from mdi_envs.mechanics.compiled import compile_equations
@@ -31,6 +29,7 @@ from mdi_envs.stepping._kernel import (
     make_step_kernels,
     make_workspace,
 )
+from mdi_envs.stepping._screen import INPUT_PROBLEMS, STATUS_OF_CODE, screen_inputs
 from mdi_envs.stepping._spatial_kernel import (
     INFO_LIFTED_CONTACTS,
     INFO_MODE,
@@ -38,9 +37,7 @@ from mdi_envs.stepping._spatial_kernel import (
     make_spatial_step_kernels,
     make_spatial_workspace,
 )
-
-if TYPE_CHECKING:
-    from mdi_envs.stepping.in_place import InPlaceStepper
+from mdi_envs.stepping.in_place import InPlaceStepper
 
 _KERNELS: dict[tuple[type[ModelDefinition], StepShortcuts, bool], tuple[Any, Any]] = {}
 
@@ -192,9 +189,7 @@ class MoreauJeanStepper:
         One compiled call per step, the fastest single steps from Python (see
         ``mdi_envs.stepping.in_place``).
         """
-        from mdi_envs.stepping.in_place import InPlaceStepper as in_place_stepper  # a cycle
-
-        return in_place_stepper(self, q, u)
+        return InPlaceStepper(self, q, u)
 
     @property
     def info_size(self) -> int:
@@ -223,9 +218,9 @@ class MoreauJeanStepper:
         tau_arr = self._vector(tau, "tau", self.num_inputs)
         brake = (self._released if brake_bound is None
                  else self._vector(brake_bound, "brake_bound", self.num_brakes))
-        problem = _screen_inputs(q_arr, u_arr, tau_arr, brake)
+        problem = screen_inputs(q_arr, u_arr, tau_arr, brake)
         if problem:
-            raise ValueError(_INPUT_PROBLEMS[problem])
+            raise ValueError(INPUT_PROBLEMS[problem])
         q_out, u_out = np.empty(self.num_dofs), np.empty(self.num_dofs)
         impulses = (np.zeros(self.num_impulses) if warm_start is None
                     else self._vector(warm_start, "warm_start", self.num_impulses).copy())
@@ -236,7 +231,7 @@ class MoreauJeanStepper:
         if self._info_size == SPATIAL_INFO_SIZE:
             mode, lifted = int(info[INFO_MODE]), int(info[INFO_LIFTED_CONTACTS])
         return StepResult(
-            q_out, u_out, impulses, _STATUS_OF_CODE[int(info[INFO_STATUS])],
+            q_out, u_out, impulses, STATUS_OF_CODE[int(info[INFO_STATUS])],
             int(info[INFO_ITERATIONS]), int(info[INFO_ACTIVE_CONTACTS]),
             int(info[INFO_LCP_SIZE]), int(info[INFO_EQUALITIES]), mode, lifted,
         )
@@ -329,34 +324,6 @@ class MoreauJeanStepper:
         if np.isnan(array).any() or (array < 0.0).any():
             raise ValueError("brake_bound must be >= 0 (0 released, inf ideal), got NaN or < 0")
         return array
-
-
-_STATUS_OF_CODE = tuple(SolverStatus)
-_INPUT_PROBLEMS = (
-    "",
-    "q contains NaN or inf entries",
-    "u contains NaN or inf entries",
-    "tau contains NaN or inf entries",
-    "brake_bound must be >= 0 (0 released, inf ideal), got NaN or < 0",
-)
-
-
-@njit(cache=True, **REFERENCE_COUNTED)
-def _screen_inputs(q: FloatArray, u: FloatArray, tau: FloatArray, brake: FloatArray) -> int:
-    """0 if the step's inputs are valid, else the index of the problem in ``_INPUT_PROBLEMS``."""
-    for v in q:
-        if not np.isfinite(v):
-            return 1
-    for v in u:
-        if not np.isfinite(v):
-            return 2
-    for v in tau:
-        if not np.isfinite(v):
-            return 3
-    for v in brake:
-        if not v >= 0.0:
-            return 4
-    return 0
 
 
 __all__ = ["MoreauJeanStepper", "StepResult"]
