@@ -24,12 +24,11 @@ $(VENV)/.installed-%: pyproject.toml
 demo: $(VENV)/.installed-rl,render
 	$(BIN)/mdi-envs compile all
 	$(BIN)/mdi-envs demo --output results/demo
-	$(BIN)/mdi-envs compare all --output results/compare
 
 test: $(VENV)/.installed-test
 	$(BIN)/mdi-envs compile all
 	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=10
-	$(BIN)/mdi-envs bench --quick
+	$(BIN)/python -m mdi_envs bench --quick
 
 # The docs site (MkDocs Material + mkdocstrings) into site/; strict: a broken link or reference
 # fails. Its generated pages read the committed JSON and parse the sources (nothing compiles).
@@ -37,11 +36,12 @@ docs: $(VENV)/.installed-docs
 	NO_MKDOCS_2_WARNING=1 DISABLE_MKDOCS_2_WARNING=true $(BIN)/mkdocs build --strict
 
 bench: $(VENV)/.installed-bench
-	$(BIN)/mdi-envs bench
+	$(BIN)/python -m mdi_envs bench
 
 lint: $(VENV)/.installed-dev
 	$(BIN)/ruff check mdi_envs optimal baselines tests benchmarks docs
 	$(BIN)/mypy mdi_envs
+	$(BIN)/lint-imports
 
 clean:
 	rm -rf $(VENV) results site .pytest_cache .hypothesis

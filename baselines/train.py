@@ -34,7 +34,6 @@ import csv
 import importlib
 import json
 import platform
-import subprocess
 import sys
 import time
 import warnings
@@ -47,6 +46,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 import mdi_envs
 from baselines.hyperparameters import ALGORITHM_CLASSES, canonical_algorithm, get_hyperparameters
+from mdi_envs.provenance import git_commit
 
 EPISODE_COLUMNS = ("timesteps", "return", "length", "is_success", "elapsed_time", "effort")
 """Columns of ``STEM_episodes.csv`` (steps, -, steps, bool, s, N^2 m^2 s)."""
@@ -344,19 +344,6 @@ def versions() -> dict[str, str]:
     return {"python": platform.python_version(), "mdi_envs": mdi_envs.__version__,
             "stable_baselines3": stable_baselines3.__version__, "torch": torch.__version__,
             "gymnasium": gym.__version__, "numpy": np.__version__}  # fmt: skip
-
-
-def git_commit() -> str | None:
-    """The repository's HEAD commit ("+dirty" with uncommitted changes); None outside git."""
-    root = Path(__file__).resolve().parent.parent
-    try:
-        commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True,
-                                text=True, check=True, timeout=10).stdout.strip()  # fmt: skip
-        dirty = subprocess.run(["git", "status", "--porcelain"], cwd=root, capture_output=True,
-                               text=True, check=True, timeout=10).stdout.strip()  # fmt: skip
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return commit + ("+dirty" if dirty else "")
 
 
 __all__ = [

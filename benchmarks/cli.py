@@ -8,6 +8,14 @@ fails (``--quick`` runs inside ``make test`` and so checks the stress criteria o
 
 Registered in ``pyproject.toml`` as the ``mdi_envs.commands`` entry point ``bench`` (the
 plug-in interface is in ``mdi_envs/cli.py``); its handler is ``run_bench``.
+
+The benchmarks are not installed with the package (``pyproject.toml`` lists ``mdi_envs``,
+``optimal`` and ``baselines`` only): they measure this repository's code, write their results
+into its ``benchmarks/results`` and run their probes as ``python -m benchmarks.NAME`` from its
+root, so they need the source tree anyway, and an installed top-level package named
+``benchmarks`` would shadow any other of that generic name. Run them from the repository's
+root: ``python -m mdi_envs bench`` (``-m`` puts the current folder on the import path; the
+``mdi-envs`` script does not) or ``make bench``.
 """
 
 from __future__ import annotations

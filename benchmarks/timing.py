@@ -37,6 +37,8 @@ from typing import Any
 
 import numpy as np
 
+from mdi_envs.provenance import git_commit
+
 
 @dataclass(frozen=True)
 class TimingPlan:
@@ -187,21 +189,6 @@ def _cpu_model() -> str:
     return platform.processor()
 
 
-def _git_commit() -> str | None:
-    """``git rev-parse HEAD`` of the repository (read-only), or None."""
-    try:
-        process = subprocess.run(
-            ["git", "rev-parse", "HEAD"],
-            cwd=Path(__file__).resolve().parents[1],
-            capture_output=True,
-            text=True,
-            check=True,
-        )
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    return process.stdout.strip()
-
-
 VERSIONED_PACKAGES = ("numpy", "scipy", "numba", "llvmlite", "quantecon", "mdi-envs")
 """Distributions whose versions ``machine_info`` records by default."""
 
@@ -308,7 +295,7 @@ def machine_info(packages: tuple[str, ...] = VERSIONED_PACKAGES) -> dict[str, An
         "load_average_at_start": load_average(),
         "speed_probe_at_start": speed_probe(),
         "versions": {name: _package_version(name) for name in packages},
-        "git_commit": _git_commit(),
+        "git_commit": git_commit(),
     }
 
 

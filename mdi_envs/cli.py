@@ -24,6 +24,9 @@ distribution's metadata, e.g. in ``pyproject.toml``::
   dependencies inside its handler, so that its own ``--help`` stays quick.
 * Entry points are read from the installed metadata: after adding or renaming one, reinstall
   (``pip install --no-deps -e .``).
+* A registered package need not be installed: ``benchmarks`` is not (see ``benchmarks/cli.py``)
+  and runs from the repository's root as ``python -m mdi_envs bench``, which puts the current
+  folder on the import path.
 """
 
 from __future__ import annotations
@@ -125,7 +128,8 @@ def _add_plugin(commands: Any, name: str, entry: EntryPoint) -> None:
         add_parser = entry.load()
     except ImportError as error:
         raise SystemExit(f"mdi-envs {name}: its plug-in {entry.value} cannot be imported "
-                         f"({error})") from error
+                         f"({error}); a plug-in package that is not installed runs from the "
+                         f"folder that holds it: python -m mdi_envs {name}") from error
     add_parser(commands)
     if name not in commands.choices:
         raise RuntimeError(f"the {COMMAND_GROUP} entry point {name} = {entry.value} did not add "

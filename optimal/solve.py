@@ -9,14 +9,13 @@ from __future__ import annotations
 import dataclasses
 import os
 import platform
-import subprocess
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from mdi_envs.provenance import git_commit
 from optimal.continuation import SCHEDULES, Schedule, solve_continuation
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
@@ -176,7 +175,7 @@ def _metadata(problem: OptimalControlProblem, cost: float, final_time: float,
         "time_step": final_time / problem.num_intervals,
         "torque_bound": problem.torque_bound,
         "converged": converged,
-        "commit": _commit(),
+        "commit": git_commit() or "unknown",
         "casadi": _casadi_version(),
         "python": platform.python_version(),
     }
@@ -227,19 +226,6 @@ def _solve_start(name: str, num_intervals: int | None, schedule: Schedule | None
 
 def _short(errors: dict[str, float]) -> str:
     return ", ".join(f"{key} {value:.1e}" for key, value in errors.items())
-
-
-def _commit() -> str:
-    """The repository's HEAD (with "+dirty" for uncommitted changes), or "unknown"."""
-    root = Path(__file__).resolve().parent.parent
-    try:
-        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True,
-                              text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain"], cwd=root, capture_output=True,
-                               text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-    return head + ("+dirty" if dirty else "")
 
 
 def _casadi_version() -> str:

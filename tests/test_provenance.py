@@ -1,0 +1,25 @@
+"""``git_commit``: the checkout's HEAD, marked dirty when it has changes; None outside git."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from mdi_envs import provenance
+
+
+def test_git_commit_is_the_checkouts_head() -> None:
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=provenance.ROOT, capture_output=True,
+                          text=True, check=True).stdout.strip()  # fmt: skip
+    changes = subprocess.run(["git", "status", "--porcelain"], cwd=provenance.ROOT,
+                             capture_output=True, text=True, check=True).stdout.strip()
+    assert provenance.git_commit() == head + ("+dirty" if changes else "")
+
+
+def test_git_commit_is_none_outside_a_checkout(tmp_path: Path,
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(provenance, "ROOT", tmp_path)
+    monkeypatch.setenv("GIT_CEILING_DIRECTORIES", str(tmp_path.parent))
+    assert provenance.git_commit() is None
