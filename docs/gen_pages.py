@@ -52,8 +52,9 @@ def copy_image(source: Path, folder: str) -> str:
 
 
 def table(rows: list[dict[str, Any]], floatfmt: str = ".4g") -> str:
-    """A Markdown table of records (pandas ``to_markdown``)."""
-    return pd.DataFrame(rows).to_markdown(index=False, floatfmt=floatfmt)
+    """A Markdown table of records (pandas ``to_markdown``); notes naming issues are dropped."""
+    frame = pd.DataFrame(rows).replace(r"\s*\([^()]*\bissue\b[^()]*\)", "", regex=True)
+    return frame.to_markdown(index=False, floatfmt=floatfmt)
 
 
 # --- environments -----------------------------------------------------------------------------
@@ -148,7 +149,7 @@ def machine_text(run: dict[str, Any]) -> str:
     load = machine.get("load_average_at_start")
     return (f"Run {machine.get('date', '?')[:10]} at commit `{machine.get('git_commit', '?')[:7]}`"
             f" on {machine.get('cpu_count', '?')} cores ({machine.get('cpu_model', '?')}), load "
-            f"average at start {load[0] if load else '?'}.")
+            f"average at start {f'{load[0]:.1f}' if load else '?'}.")
 
 
 BENCHMARKS = {  # file stem: (title, the command that writes it)
@@ -163,6 +164,32 @@ BENCHMARKS = {  # file stem: (title, the command that writes it)
     "vec_env_throughput": ("SB3 training throughput", "python -m benchmarks.vec_env_throughput"),
     "before_after": ("Before/after speed comparison", "python -m benchmarks.before_after"),
 }
+
+
+def solver_tables(run: dict[str, Any]) -> list[str]:
+    """Lemke against QuantEcon: median time ratios, the fixed cost per call, the peer problems."""
+    comparison = run["quantecon_comparison"]
+    ratios = [{"problems": r["set"], "count": r["problems"],
+               "driver / QuantEcon": r["median_ratio_driver"],
+               "lemke_solve / QuantEcon": r["median_ratio_kernel"]}
+              for r in comparison["median_ratios"]]
+
+    def micro(entry: dict[str, Any]) -> float:
+        return 1e6 * entry["time"]["median_s"]
+
+    fixed = [{"problem": r["name"], "driver [µs]": micro(r["driver"]),
+              "lemke_solve [µs]": micro(r["kernel"]), "QuantEcon [µs]": micro(r["quantecon"])}
+             for r in run["fixed_cost"]]
+    peers = [{"problem": r["name"], "n": r["n"],
+              **{f"{entry} {key}": r[entry]["outcome"][key]
+                 for entry in ("driver", "quantecon") for key in ("status", "iterations")},
+              "residual (driver)": r["driver"]["outcome"]["residual"]}
+             for r in comparison["problems"] if r["family"] == "siconos"]
+    return ["Median time ratios of Lemke (through the public driver `solve_lcp`, and its "
+            "compiled entry `lemke_solve`) to QuantEcon's `lcp_lemke`, same problems, same "
+            "run:", "", table(ratios, floatfmt=".3g"), "", "Fixed cost per call:", "",
+            table(fixed, floatfmt=".3g"), "", "The Siconos LCPs (status and pivots of both):",
+            "", table(peers, floatfmt=".2g"), ""]
 
 
 def benchmark_page() -> None:
@@ -187,6 +214,8 @@ def benchmark_page() -> None:
         lines += [f"## {title}", "", f"`{command}` writes `benchmarks/results/{stem}.json`. "
                   + machine_text(run), ""]
         targets = run.get("targets") or run.get("rows")
+        if stem == "solvers":
+            lines += solver_tables(run)
         if stem == "stress":
             targets = [{"family": c["family"], "case": c["name"], "passed": c["passed"]}
                        for c in run["cases"]]
@@ -221,7 +250,27 @@ def comparison_page() -> None:
              headline.headline_frame(runs).to_markdown(index=False), ""]
     for png in sorted(folder.glob("*.png")):
         lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    lines += ["## Shipped policies", "",
+              "Every trained run in `baselines/trained/` (`STEM.json`: the exact arguments, "
+              "versions and commit; `STEM.zip`: the model). Training success is over the last "
+              "100 training episodes; the evaluation is `mdi-envs train`'s own (deterministic "
+              "actions, from the nominal start).", "", table(trained_rows()), ""]
     write("results/comparison.md", "\n".join(lines))
+
+
+def trained_rows() -> list[dict[str, Any]]:
+    """One row per shipped policy, from its ``STEM.json``."""
+    rows = []
+    for path in sorted((ROOT / "baselines" / "trained").glob("*.json")):
+        run = load(path)
+        evaluation = run.get("evaluation") or {}
+        rows.append({"policy": path.stem, "steps": run.get("num_timesteps"),
+                     "copies": run.get("num_envs"),
+                     "wall time [min]": run["wall_time_s"] / 60 if "wall_time_s" in run else None,
+                     "training success": (run.get("train_last100") or {}).get("success_rate"),
+                     "evaluation success": evaluation.get("success_rate"),
+                     "commit": str(run.get("commit", ""))[:7]})
+    return rows
 
 
 def robustness_page() -> None:
