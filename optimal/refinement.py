@@ -111,19 +111,7 @@ def refine(problem: OptimalControlProblem, solve: ModeSolve, factors: Sequence[i
         _interpolated_guess(guess, previous)
         fixed = solve_with_modes(fine, pattern, initial=guess.initial_point(), transcription=guess,
                                  mu_strategy=mu_strategy)
-        best = fixed
-        transcription = Transcription(fine)
-        freed = solve_continuation(transcription, FREEING_SCHEDULE, initial=fixed.point)
-        if freed.success:
-            solved = freed.transcription or transcription
-            point = np.asarray(freed.values(solved.opti.x), dtype=float).ravel()
-            again = solve_with_modes(fine, read_modes(solved, freed.values), initial=point)
-            if again.success and (not best.success or again.cost < best.cost):
-                best = again
-        moves: list[str] = []
-        if best.success:
-            local = improve_modes(fine, best, max_rounds=max_rounds)
-            best, moves = local.best, [step.move for step in local.steps]
+        best, moves = settle(fine, fixed, max_rounds)
         level = Level(factor, fine, best, _phases(best), time.perf_counter() - clock, moves)
         levels.append(level)
         if progress is not None:
@@ -131,6 +119,29 @@ def refine(problem: OptimalControlProblem, solve: ModeSolve, factors: Sequence[i
                      f"{best.final_time:.5f} s, converged {best.success}, "
                      f"{len(moves)} moves ({level.wall_time:.0f} s)")
     return Refinement(levels)
+
+
+def settle(problem: OptimalControlProblem, fixed: ModeSolve, max_rounds: int = 8
+           ) -> tuple[ModeSolve, list[str]]:
+    """Free a fixed-pattern solve and search its mode neighbourhood.
+
+    The continuation's last stage and polish from ``fixed`` (``FREEING_SCHEDULE``: the modes
+    may move), its optimum re-solved with its modes fixed, then ``improve_modes`` from the
+    better of the two; returns the best solve and the moves accepted.
+    """
+    best = fixed
+    transcription = Transcription(problem)
+    freed = solve_continuation(transcription, FREEING_SCHEDULE, initial=fixed.point)
+    if freed.success:
+        solved = freed.transcription or transcription
+        point = np.asarray(freed.values(solved.opti.x), dtype=float).ravel()
+        again = solve_with_modes(problem, read_modes(solved, freed.values), initial=point)
+        if again.success and (not best.success or again.cost < best.cost):
+            best = again
+    if not best.success:
+        return best, []
+    local = improve_modes(problem, best, max_rounds=max_rounds)
+    return local.best, [step.move for step in local.steps]
 
 
 def _interpolated_guess(fine: Transcription, coarse: Level) -> None:
@@ -164,4 +175,4 @@ def _phases(solve: ModeSolve) -> dict[str, list[tuple[float, float]]]:
     return solve.found_modes.phases(grid)
 
 
-__all__ = ["FREEING_SCHEDULE", "Level", "Refinement", "refine"]
+__all__ = ["FREEING_SCHEDULE", "Level", "Refinement", "refine", "settle"]
