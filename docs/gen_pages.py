@@ -153,14 +153,14 @@ def machine_text(run: dict[str, Any]) -> str:
 
 
 BENCHMARKS = {  # file stem: (title, the command that writes it)
-    "solvers": ("LCP solvers", "mdi-envs bench solvers"),
-    "fc3d": ("Spatial friction (Siconos fc3d problems)", "mdi-envs bench fc3d"),
-    "engine": ("Engine: the Moreau-Jean step", "mdi-envs bench engine"),
-    "envs": ("Environments: env.step and vector envs", "mdi-envs bench envs"),
+    "solvers": ("LCP solvers", "python -m mdi_envs bench solvers"),
+    "fc3d": ("Spatial friction (Siconos fc3d problems)", "python -m mdi_envs bench fc3d"),
+    "engine": ("Engine: the Moreau-Jean step", "python -m mdi_envs bench engine"),
+    "envs": ("Environments: env.step and vector envs", "python -m mdi_envs bench envs"),
     "work_precision": ("Work-precision against MuJoCo and the event-driven reference",
-                       "mdi-envs bench precision"),
-    "stress": ("Stress cases", "mdi-envs bench stress"),
-    "startup": ("Start-up", "mdi-envs bench startup"),
+                       "python -m mdi_envs bench precision"),
+    "stress": ("Stress cases", "python -m mdi_envs bench stress"),
+    "startup": ("Start-up", "python -m mdi_envs bench startup"),
     "vec_env_throughput": ("SB3 training throughput", "python -m benchmarks.vec_env_throughput"),
     "before_after": ("Before/after speed comparison", "python -m benchmarks.before_after"),
 }
@@ -197,8 +197,9 @@ def benchmark_page() -> None:
     folder = ROOT / "benchmarks" / "results"
     lines = ["# Benchmark results", "",
              "Generated from the committed JSON in `benchmarks/results/` (written by "
-             "`mdi-envs bench`; `make bench` runs them all). What each benchmark measures: "
-             "[the benchmarks guide](../guide/benchmarks.md).", ""]
+             "`python -m mdi_envs bench` from the repository's root; `make bench` runs them "
+             "all). What each benchmark measures: [the benchmarks guide]"
+             "(../guide/benchmarks.md).", ""]
     headline = folder / "headline.json"
     if headline.exists():
         rows = [{k: r.get(k) for k in ("benchmark", "target", "measured", "comparison",
