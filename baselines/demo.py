@@ -100,8 +100,9 @@ def _play(config: dict[str, Any], record: bool = False) -> Rollout:
     from baselines.train import load_trained
 
     model = load_trained(config["algo"], config["path"])
+    env_kwargs = {**config["env_kwargs"], "reset_noise_scale": 0.0}
     return rollout(config["env_id"], lambda obs: model.predict(obs, deterministic=True)[0],
-                   record=record, reset_noise_scale=0.0, **config["env_kwargs"])  # fmt: skip
+                   record=record, **env_kwargs)  # fmt: skip
 
 
 def _outcome(result: Rollout) -> str:
