@@ -158,7 +158,7 @@ def simulate_schedule(integrator: EventDrivenIntegrator, problem: OptimalControl
 
     Args:
         integrator: for ``problem.model``. problem: start state and torque bound.
-        schedule: the mode sequence and times. sample_times: (T,) times in [0, t_f] [s].
+        schedule: the mode sequence and times. sample_times: (T,) times [s], within [0, t_f].
     """
     t_f = schedule.final_time
     rows = [np.clip(np.maximum.accumulate(np.asarray(row, dtype=float)), 0.0, t_f)
