@@ -102,13 +102,18 @@ def target_value(value: float | None, unit: str) -> str:
 
 
 def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
-    """Markdown: target, threshold, measured, ✓/✗ (``not measured``), note."""
+    """Markdown: target, threshold, measured, met (✓, ✗, ``–`` undecided, not measured), note."""
+    def threshold(t: Mapping[str, Any]) -> str:
+        if t["threshold"] is None:
+            return "(comparison)"
+        unit = t["unit"] if t["unit"] in ("×", "") else f" {t['unit']}"
+        return f"{t['comparison']} {t['threshold']:g}{unit}"
+
     return markdown_table([{
-        "target": t["target"],
-        "threshold": ("(comparison)" if t["threshold"] is None else
-                      f"{t['comparison']} {target_value(t['threshold'], t['unit'])}"),
+        "target": t["target"], "threshold": threshold(t),
         "measured": target_value(t["measured"], t["unit"]),
-        "met": "not measured" if t["met"] is None else ("✓" if t["met"] else "✗"),
+        "met": {True: "✓", False: "✗"}.get(t["met"], "–" if t["measured"] is not None
+                                            else "not measured"),
         "note": t["note"]} for t in targets])  # fmt: skip
 
 

@@ -3,8 +3,9 @@
 ``time_interleaved`` runs its callables in rounds A B C, A B C, ... so that a change of machine
 load (the benchmark machine is shared) hits every callable alike. Each callable first gets one
 untimed warm-up call (whose duration sizes the rest), then, per round, a batch of ``number``
-back-to-back calls long enough (``min_batch_s``) for ``time.perf_counter`` to resolve it; the
-reported time per call is the median over rounds of batch time / number.
+back-to-back calls (``timeit.Timer.timeit``, garbage collection left on) long enough
+(``min_batch_s``) for the clock to resolve it; the reported time per call is the median over
+rounds of batch time / number.
 
 Why not pytest-benchmark or pyperf: both time one benchmark's rounds (pyperf: its worker
 processes) before the next benchmark's, so a slow phase of this shared VM (seconds long, about
@@ -29,6 +30,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import timeit
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import metadata
@@ -103,14 +105,6 @@ def _timed_call(call: Callable[[], Any]) -> tuple[Any, float]:
     return result, time.perf_counter() - start
 
 
-def _batch(call: Callable[[], Any], number: int) -> float:
-    """Seconds per call of ``number`` back-to-back calls."""
-    start = time.perf_counter()
-    for _ in range(number):
-        call()
-    return (time.perf_counter() - start) / number
-
-
 def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -> dict[str, Timed]:
     """Time several callables in interleaved rounds (see the module docstring).
 
@@ -129,9 +123,10 @@ def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -
     slowest = max(numbers[name] * warm[name][1] for name in calls)
     rounds = min(plan.max_rounds, max(plan.min_rounds, int(plan.budget_s / max(slowest, 1e-9))))
     samples: dict[str, list[float]] = {name: [] for name in calls}
+    timers = {name: timeit.Timer(call, setup="gc.enable()") for name, call in calls.items()}
     for _ in range(rounds):
-        for name, call in calls.items():
-            samples[name].append(_batch(call, numbers[name]))
+        for name, timer in timers.items():
+            samples[name].append(timer.timeit(numbers[name]) / numbers[name])
     timed = {}
     for name, values in samples.items():
         q1, median, q3 = np.percentile(values, [25, 50, 75])

@@ -72,6 +72,7 @@ from __future__ import annotations
 
 import math
 import time
+import timeit
 import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
@@ -264,23 +265,22 @@ class Context:
 
 
 def wall_time(call: Callable[[], Any], min_repeats: int, budget_s: float, max_repeats: int
-              ) -> tuple[float, int, Any]:
-    """Best wall time of ``call()`` after one untimed warm-up call.
+              ) -> tuple[float, int, Any]:  # fmt: skip
+    """Best wall time of ``call()`` (``timeit.Timer.repeat``, one call per repeat, GC on).
 
-    Runs ``min_repeats`` timed calls, then more while their total stays under ``budget_s`` [s],
-    up to ``max_repeats``.
+    One untimed warm-up call first; then as many timed calls as fit in ``budget_s`` [s] by the
+    warm-up's duration, at least ``min_repeats`` and at most ``max_repeats``.
 
     Returns:
-        (best seconds, timed repeats, the last call's return value).
+        (best seconds, timed repeats, the warm-up call's return value: every call here restarts
+        from the same state, so all return the same).
     """
+    start = time.perf_counter()
     result = call()
-    best, repeats, spent = math.inf, 0, 0.0
-    while repeats < max(min_repeats, 1) or (spent < budget_s and repeats < max_repeats):
-        start = time.perf_counter()
-        result = call()
-        elapsed = time.perf_counter() - start
-        best, repeats, spent = min(best, elapsed), repeats + 1, spent + elapsed
-    return best, repeats, result
+    first = time.perf_counter() - start
+    repeats = min(max_repeats, max(min_repeats, 1, int(budget_s / max(first, 1e-9))))
+    timer = timeit.Timer(call, setup="gc.enable()")
+    return min(timer.repeat(repeat=repeats, number=1)), repeats, result
 
 
 class Copies:
@@ -319,6 +319,21 @@ class Copies:
     def state(self, copy: int = 0) -> np.ndarray:
         """(q, u) of one copy, concatenated (2n,)."""
         return np.concatenate([self.q[copy], self.u[copy]])
+
+    def run(self, phases: Sequence[tuple[int, Sequence[float], Sequence[float]]]) -> np.ndarray:
+        """From the initial states through (steps, inputs, brake bounds) phases, one call each.
+
+        Returns:
+            Copy 0's final ``state()``; ``worst_status`` holds the worst ``SolverStatus`` code
+            of copy 0 over the phases.
+        """
+        self.reset()
+        self.worst_status = 0
+        for steps, tau, brake in phases:
+            self.command(tau, brake)
+            self.advance(steps)
+            self.worst_status = max(self.worst_status, int(self.out[1][0, INFO_STATUS]))
+        return self.state()
 
 
 def point(scene: str, series: str, parameter: str, value: float, wall_s: float, repeats: int,
@@ -472,13 +487,7 @@ def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
             st = ctx.stepper(BouncingBall, p, dt, method, locate_impacts)
             num_steps = math.ceil(horizon / dt)
             single = Copies(st, *(a[:1] for a in _ball_initial(p, gaps)))
-
-            def run(single: Copies = single, num_steps: int = num_steps) -> np.ndarray:
-                single.reset()
-                single.advance(num_steps)
-                return single.state()
-
-            wall, repeats, final = ctx.timed(run)
+            wall, repeats, final = ctx.timed(partial(single.run, [(num_steps, (0.0,), ())]))
             replay = Copies(st, *_ball_initial(p, gaps))
             y = np.empty((gaps.size, num_steps + 1))
             v = np.empty_like(y)
@@ -610,13 +619,7 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
                              - p.friction_coefficient * math.cos(p.slope_angle)), 0.0)
         num_steps = _steps(1.0, dt)
         run = Copies(ctx.stepper(SlidingBlock, p, dt, method), np.zeros((1, 2)), np.zeros((1, 2)))
-
-        def call() -> np.ndarray:
-            run.reset()
-            run.advance(num_steps)
-            return run.state()
-
-        wall, repeats, final = ctx.timed(call)
+        wall, repeats, final = ctx.timed(partial(run.run, [(num_steps, (0.0,), ())]))
         exact = np.array([0.5 * a, 0.0, a, 0.0])  # (s, n, s', n') at T = 1 s
         errors = {"error": float(np.abs(final - exact).max())}
         return point("slope", series, "dt", dt, wall, repeats, "mj_one_call", errors)
@@ -696,15 +699,8 @@ def manipulator_moreau_jean(ctx: Context, reference: np.ndarray) -> list[dict[st
         phases = manipulator_phases(dt)
         run = Copies(st, np.zeros((1, 2)), np.zeros((1, 2)))
         stride = _steps(SAMPLE_INTERVAL, dt)
-
-        def timed(run: Copies = run, phases: list = phases) -> np.ndarray:
-            run.reset()
-            for steps, torque, bound in phases:
-                run.command([torque], [bound])
-                run.advance(steps)
-            return run.state()
-
-        wall, repeats, final = ctx.timed(timed)
+        wall, repeats, final = ctx.timed(partial(
+            run.run, [(steps, [torque], [bound]) for steps, torque, bound in phases]))
         run.reset()
         samples = [run.state()]
         for steps, torque, bound in phases:
@@ -767,51 +763,38 @@ def manipulator_mujoco(ctx: Context, reference: np.ndarray) -> list[dict[str, An
 
 
 # ---------------------------------------------------------------------------------- diff-drive
-def diff_drive_run(ctx: Context, dt: float) -> tuple[Callable[[], np.ndarray], list[int]]:
-    """A zero-argument run of the robot's phases at dt (one call per phase).
+def diff_drive_run(ctx: Context, dt: float) -> tuple[Callable[[], np.ndarray], Copies]:
+    """A zero-argument run of the robot's phases at dt (one call per phase), and its copies.
 
-    Returns:
-        (the run, returning the final state (10,); a list whose item 0 the run sets to the worst
-        ``SolverStatus`` code over its steps).
+    The run returns the final state (10,); the copies' ``worst_status`` is the worst
+    ``SolverStatus`` code over its steps.
     """
-    st = ctx.stepper(DiffDriveRobot, None, dt)
-    run = Copies(st, np.zeros((1, 5)), np.zeros((1, 5)))
-    phases = [(_steps(duration, dt), tau) for duration, tau in DIFF_DRIVE_PHASES]
-    worst = [0]
-
-    def call() -> np.ndarray:
-        run.reset()
-        worst[0] = 0
-        for steps, tau in phases:
-            run.command(tau)
-            run.advance(steps)
-            worst[0] = max(worst[0], int(run.out[1][0, INFO_STATUS]))
-        return run.state()
-
-    return call, worst
+    run = Copies(ctx.stepper(DiffDriveRobot, None, dt), np.zeros((1, 5)), np.zeros((1, 5)))
+    return partial(run.run, [(_steps(duration, dt), tau, ())
+                             for duration, tau in DIFF_DRIVE_PHASES]), run
 
 
 def diff_drive_moreau_jean(ctx: Context) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Robot points against the fine-step reference, and the reference's record."""
     dt_ref = ctx.config.diff_drive_reference_step
-    reference_run, reference_status = diff_drive_run(ctx, dt_ref)
+    reference_run, reference_copies = diff_drive_run(ctx, dt_ref)
     start = time.perf_counter()
     reference = reference_run()
     seconds = time.perf_counter() - start
     check = diff_drive_run(ctx, 2.0 * dt_ref)[0]()
     record = {"time_step": dt_ref, "check_time_step": 2.0 * dt_ref, "wall_time_s": seconds,
               "self_difference": float(np.abs(reference - check).max()),
-              "worst_status": SolverStatus(reference_status[0]).name,
+              "worst_status": SolverStatus(reference_copies.worst_status).name,
               "final_state": [float(x) for x in reference]}
     ctx.log(f"diff-drive reference dt = {dt_ref:g}: |x(2 dt_ref) - x(dt_ref)| = "
             f"{record['self_difference']:.1e}")
     points = []
     for dt in ctx.config.diff_drive_time_steps:
-        call, status = diff_drive_run(ctx, dt)
+        call, copies = diff_drive_run(ctx, dt)
         wall, repeats, final = ctx.timed(call)
         points.append(point("diff_drive", "mj_newton_ac", "dt", dt, wall, repeats,
                             "mj_per_phase", {"error": float(np.abs(final - reference).max())},
-                            worst_solver_status=SolverStatus(status[0]).name))
+                            worst_solver_status=SolverStatus(copies.worst_status).name))
         _log_point(ctx.log, points[-1])
     return points, record
 

@@ -802,10 +802,10 @@ def block_mu_case(mu: float) -> list[dict[str, Any]]:
         criteria)]
 
 
-def block_mu_grid() -> list[float]:
+def block_mu_grid(config: StressConfig) -> list[float]:
     """The friction coefficients of ``block_mu_case``: the grid and tan(theta) (1 -+ 1e-3)."""
     threshold = math.tan(SlidingBlock.Parameters().slope_angle)
-    return sorted({*CONFIG.block_mu_grid, threshold * (1 - 1e-3), threshold * (1 + 1e-3)})
+    return sorted({*config.block_mu_grid, threshold * (1 - 1e-3), threshold * (1 + 1e-3)})
 
 
 def _robot_rolls(p: Any, torque: float) -> bool:
@@ -1306,7 +1306,7 @@ def plan(config: StressConfig = CONFIG) -> list[PlannedCase]:
               for model in _sweep_scenes() if model in models for dt in config.dt_grid]
     if "block" in models:
         cases += [PlannedCase(f"mu sweep block mu={mu:.4g}", "mu_sweep", block_mu_case, (mu,))
-                  for mu in block_mu_grid()]
+                  for mu in block_mu_grid(config)]
     if "diff_drive" in models:
         cases += [PlannedCase(f"mu sweep diff_drive mu={mu:g}", "mu_sweep", robot_mu_case, (mu,))
                   for mu in config.robot_mu_grid]

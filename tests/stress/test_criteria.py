@@ -13,7 +13,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from peer_data import peer_files
 from stress.cases import (
+    FULL,
+    QUICK,
     Trace,
     at_least,
     at_most,
@@ -44,6 +47,8 @@ def test_plan_covers_every_family_once_per_name() -> None:
                     for located in (False, True)]
     dts = {c.args[1] for c in cases if c.family == "dt_sweep"}
     assert min(dts) == 1e-6 and max(dts) == 0.1
+    peers = bool(peer_files("lcp"))  # the Siconos files are one case where they are present
+    assert (len(plan(FULL)), len(plan(QUICK))) == (80 + peers, 58 + peers)
 
 
 def _trace(q: np.ndarray, status: np.ndarray) -> Trace:
