@@ -158,7 +158,7 @@ QUICK = EngineConfig(
 )
 
 TARGETS_US = {"manipulator_batched": 0.1, "manipulator_python": 1.0, "diff_drive": 2.0}
-"""The brief's targets [µs]."""
+"""The speed targets [µs]."""
 
 
 def _first_batch(st: MoreauJeanStepper, case: ModelCase) -> None:
@@ -462,7 +462,7 @@ def brake_stop_study(steppers: dict[str, MoreauJeanStepper], arm: MujocoArm | No
 
 
 def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, Any]]:
-    """The brief's targets against the measurements (None where the model was not run)."""
+    """The speed targets against the measurements (None where the model was not run)."""
 
     def python_worst(model: str) -> float | None:
         values = [r["median_s"] for r in single

@@ -62,7 +62,7 @@ TARGETS = {
     "manipulator_physics_steps_per_s": 5e6,
     "manipulator_vector_copies": 4096,
 }
-"""The brief's targets: manipulator ``env.step`` <= 10 µs, >= 3x faster than Acrobot-v1,
+"""The targets: manipulator ``env.step`` <= 10 µs, >= 3x faster than Acrobot-v1,
 >= 5e6 physics steps/s of the manipulator vector env at num_envs = 4096 on one core."""
 
 UNITS = {
@@ -408,7 +408,7 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str]
 
 def evaluate_targets(single: Sequence[dict[str, Any]], vector: Sequence[dict[str, Any]]
                      ) -> list[dict[str, Any]]:
-    """The brief's targets against the measurements (``met`` None where not measured)."""
+    """The targets against the measurements (``met`` None where not measured)."""
     by_id = {r["env_id"]: r for r in single}
     manipulator = by_id.get(MANIPULATOR)
     step = manipulator["gym.make"]["median_us"] if manipulator else None

@@ -151,7 +151,7 @@ def _ratios(warm: dict[str, Any], entries: Sequence[str]) -> dict[str, float]:
 
 def _targets(record: dict[str, Any], env_ids: Sequence[str],
              entries: Sequence[str]) -> list[dict[str, Any]]:
-    """The issue's targets in the headline schema (``benchmarks.headline``)."""
+    """The start-up targets (``benchmarks.report.target_row``)."""
     ratios = {key: ratio for key, ratio in record["ratios_to_acrobot"].items()
               if key.split(" ")[0] in env_ids and key.rsplit(" ", 1)[1] in ("single", "vector")}
     targets = []

@@ -62,7 +62,7 @@ stops at the samples (every step for the ball, every 4 ms for the arm); its fina
 the timed run's (``replay_difference``, 0 here). The machine is shared: times move by up to ~2x
 between runs, errors not at all.
 
-**Targets** (issue 7, reported and never enforced: ``main`` returns 0 when they are missed):
+**Targets** (reported and never enforced: ``main`` returns 0 when they are missed):
 ball apex error <= 1e-3 relative at dt = 1e-3 s; ball error O(dt) (fitted order >= 0.8); at
 equal wall time MuJoCo's ball error >= 100x ours (``work_precision_report.equal_time_comparison``);
 the ideal brake stops the relative motion in one step (``benchmarks.engine.brake_stop_study``).
@@ -811,7 +811,7 @@ def observed_order(points: Sequence[dict[str, Any]]) -> float | None:
 
 def evaluate_targets(points: Sequence[dict[str, Any]], brake: dict[str, Any] | None
                      ) -> tuple[list[dict[str, Any]], dict[str, Any] | None]:
-    """The issue's targets against the measurements, and the ball's equal-time comparison."""
+    """The targets against the measurements, and the ball's equal-time comparison."""
     ours = [p for p in points if p["scene"] == "ball" and p["series"] == "mj_enumerative"]
     located = [p for p in points if p["scene"] == "ball" and p["series"] == "mj_located"]
     targets = []
