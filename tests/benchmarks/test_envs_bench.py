@@ -9,18 +9,13 @@ from __future__ import annotations
 
 import json
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:  # ``benchmarks`` is a folder of the repository, not installed
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.envs import EnvsConfig, run  # noqa: E402
-from benchmarks.timing import TimingPlan  # noqa: E402
+from benchmarks.envs import EnvsConfig, run
+from benchmarks.timing import TimingPlan
 
 COUNTS = (".episodes_ended",)
 """Counters that may be 0; every other number in the record must be > 0."""

@@ -10,20 +10,15 @@ from __future__ import annotations
 
 import json
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:  # ``benchmarks`` is a folder of the repository, not installed
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks import work_precision as wp  # noqa: E402
-from benchmarks import work_precision_report as wpr  # noqa: E402
-from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters  # noqa: E402
+from benchmarks import work_precision as wp
+from benchmarks import work_precision_report as wpr
+from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -27,13 +26,8 @@ from stress.cases import (
     plan,
 )
 
+from benchmarks import stress as bench_stress
 from mdi_envs.solvers.status import SolverStatus
-
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:  # ``benchmarks`` is a folder of the repository, not installed
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks import stress as bench_stress  # noqa: E402
 
 
 def test_plan_covers_every_family_once_per_name() -> None:
