@@ -292,6 +292,18 @@ def _per_copy_step(timed_summary: dict[str, Any], num_copies: int, substeps: int
     }
 
 
+def _per_copy_rows(calls: dict[str, Callable[[], Any]], substeps: dict[str, int], n: int,
+                   plan: TimingPlan, fields: tuple[str, ...]) -> list[dict[str, Any]]:
+    """Time ``calls`` interleaved; one row per call with its per-copy-step timing.
+
+    A row holds ``fields`` from the call's key (``"a|b"``) and ``_per_copy_step`` of its
+    ``n`` copies and ``substeps[key]`` substeps.
+    """
+    timed = time_interleaved(calls, plan)
+    return [{**dict(zip(fields, key.split("|"), strict=False)),
+             **_per_copy_step(value.summary(), n, substeps[key])} for key, value in timed.items()]
+
+
 def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
                 arm: MujocoArm | None, config: EngineConfig, log: Progress
                 ) -> list[dict[str, Any]]:
@@ -310,12 +322,7 @@ def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
             key = f"mujoco|{scene}"
             calls[key], substeps[key] = _mujoco_entry(arm, n, config.call_s, (scene,))
     log(f"in-kernel per scene (N = {n}): {len(calls)} callables, interleaved ...")
-    timed = time_interleaved(calls, config.batch_plan)
-    rows = []
-    for key, value in timed.items():
-        model, scene = key.split("|")
-        rows.append({"model": model, "scene": scene,
-                     **_per_copy_step(value.summary(), n, substeps[key])})
+    rows = _per_copy_rows(calls, substeps, n, config.batch_plan, ("model", "scene"))
     log("  " + ", ".join(f"{r['model']}/{r['scene']} {report.format_us_fine(r['per_copy_step_s'])}"
                          for r in rows))
     return rows
@@ -334,9 +341,7 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
             calls[case.label], substeps[case.label] = entry, entry.num_substeps
         if arm is not None:
             calls["mujoco"], substeps["mujoco"] = _mujoco_entry(arm, n, config.call_s)
-        timed = time_interleaved(calls, config.batch_plan)
-        measured = [{"model": key, **_per_copy_step(value.summary(), n, substeps[key])}
-                    for key, value in timed.items()]
+        measured = _per_copy_rows(calls, substeps, n, config.batch_plan, ("model",))
         rows += measured
         log(f"batched N = {n}: " + ", ".join(
             f"{r['model']} {report.format_us_fine(r['per_copy_step_s'])} µs (x{r['substeps']})"
@@ -353,17 +358,11 @@ def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
     if not config.substep_grid:
         return []
     n = config.scene_copies
-    calls: dict[tuple[str, int], BatchedCall] = {}
-    for case in cases:
-        for substeps in config.substep_grid:
-            calls[(case.label, substeps)] = BatchedCall(
-                steppers[case.label], batch_arrays(case, n), substeps)
+    calls = {f"{case.label}|{k}": BatchedCall(steppers[case.label], batch_arrays(case, n), k)
+             for case in cases for k in config.substep_grid}
     log(f"substeps per call (N = {n}): {len(calls)} callables, interleaved ...")
-    timed = time_interleaved({f"{m}|{k}": c for (m, k), c in calls.items()}, config.substep_plan)
-    rows = []
-    for (model, substeps), _ in calls.items():
-        rows.append({"model": model,
-                     **_per_copy_step(timed[f"{model}|{substeps}"].summary(), n, substeps)})
+    rows = _per_copy_rows(calls, {key: call.num_substeps for key, call in calls.items()}, n,
+                          config.substep_plan, ("model",))
     log("  " + ", ".join(f"{r['model']} x{r['substeps']} "
                          f"{report.format_us_fine(r['per_copy_step_s'])}"
                          for r in rows))
