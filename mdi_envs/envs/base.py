@@ -239,8 +239,9 @@ class MoreauJeanScene:
                  out: Any) -> None:  # fmt: skip
         """Write one copy's scene diagnostics (one value per ``INFO_KEYS`` entry) into ``out``.
 
-        impulses: the last physics step's impulses (c*d + k,); physics: its stepper
-        diagnostics (the ``mdi_envs.stepping`` INFO_* layout).
+        impulses: the impulses summed over the physics steps of the env step (c*d + k,);
+        physics: the stepper diagnostics of its last physics step (the ``mdi_envs.stepping``
+        INFO_* layout; the status is the worst over the env step).
         """
 
     # -- shared ----------------------------------------------------------------------------
@@ -340,7 +341,8 @@ def state_fields(scene: MoreauJeanScene) -> tuple[tuple[str, int | None], ...]:
     model, stepper = scene.MODEL, scene.stepper
     return (("q", model.NUM_DOFS), ("u", model.NUM_DOFS), ("tau", model.NUM_INPUTS),
             ("brake", model.NUM_BRAKES), ("impulses", stepper.num_impulses),
-            ("physics", stepper.info_size), ("info", len(scene.info_keys)),
+            ("step_impulses", stepper.num_impulses), ("physics", stepper.info_size),
+            ("info", len(scene.info_keys)),
             ("elapsed_steps", None), ("effort", None), ("potential", None),
             ("terminated", None), ("reward", None))  # fmt: skip
 
@@ -395,7 +397,10 @@ class BatchState:
         reward, obs, info: the last step's outputs, (N,), (N, NUM_OBSERVATIONS) float32 and
             (N, len(info_keys)).
         impulses, physics: the stepper's outputs of the last physics step (the impulses also
-            warm-start the next step's solver for spatial contacts; zero after a reset).
+            warm-start the next step's solver for spatial contacts; zero after a reset),
+            except the solver status in physics, the worst over the env step.
+        step_impulses: (N, c*d + k) the impulses summed over the physics steps of the last
+            env step (what ``info_one`` reports).
     """
 
     q: FloatArray
@@ -403,6 +408,7 @@ class BatchState:
     tau: FloatArray
     brake: FloatArray
     impulses: FloatArray
+    step_impulses: FloatArray
     physics: FloatArray
     info: FloatArray
     elapsed_steps: FloatArray
@@ -779,16 +785,25 @@ def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
 
     @njit
     def advance(levels, buffer):  # noqa: ANN001
-        (workspace_floats, workspace_ints, q, u, tau, brake, impulses, physics, info, elapsed,
-         effort, potential, terminated, reward, obs, settings) = carve_state(buffer)
+        (workspace_floats, workspace_ints, q, u, tau, brake, impulses, step_impulses, physics,
+         info, elapsed, effort, potential, terminated, reward, obs, settings) = carve_state(buffer)
         if levels.ndim > 2 or levels.size != width * q.shape[0]:
             return ADVANCE_ACTION_SHAPE
         if not decode_levels(levels, num_torques, int(settings[8]), settings[9], settings[10],
                              tau, brake):  # fmt: skip
             return ADVANCE_ACTION_NOT_FINITE
-        step_batch(q, u, tau, brake, settings[0], read_record(settings), int(settings[1]),
-                   impulses, physics, (workspace_floats, workspace_ints))
-        finite = evaluate(q, u, tau, brake, impulses, physics, settings[constants_start:],
+        # one physics step at a time, to sum each copy's impulses over the env step
+        record = read_record(settings)
+        worst = np.zeros(q.shape[0])
+        step_impulses[:] = 0.0
+        for _ in range(int(settings[1])):
+            step_batch(q, u, tau, brake, settings[0], record, 1, impulses, physics,
+                       (workspace_floats, workspace_ints))  # fmt: skip
+            step_impulses += impulses
+            for i in range(q.shape[0]):
+                worst[i] = max(worst[i], physics[i, INFO_STATUS])
+        physics[:, INFO_STATUS] = worst
+        finite = evaluate(q, u, tau, brake, step_impulses, physics, settings[constants_start:],
                           settings[2], int(settings[3]), settings[4], settings[5], settings[6],
                           settings[7], elapsed, effort, potential, terminated, reward, obs,
                           info)  # fmt: skip
@@ -805,14 +820,15 @@ def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
         """Zero the episode state of the copies ``indices`` (q, u already set), then their
         Phi and observation (see ``MoreauJeanScene.reset_copies``).
         """
-        (_, _, q, u, tau, brake, impulses, _, _, elapsed, effort, potential, terminated, _, obs,
-         settings) = carve_state(buffer)
+        (_, _, q, u, tau, brake, impulses, step_impulses, _, _, elapsed, effort, potential,
+         terminated, _, obs, settings) = carve_state(buffer)
         c = settings[constants_start:]
         horizon, dt, shaping_weight = settings[3], settings[2], settings[6]
         for i in indices:
             tau[i, :] = 0.0
             brake[i, :] = 0.0
             impulses[i, :] = 0.0
+            step_impulses[i, :] = 0.0
             elapsed[i] = 0.0
             effort[i] = 0.0
             terminated[i] = 0.0

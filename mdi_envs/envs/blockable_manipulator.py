@@ -1,5 +1,5 @@
-"""``mdi_envs/BlockableManipulator-v0``: the paper's time-optimal swing of a two-link arm with a
-motor on the first joint and an impulsive brake on the second.
+"""``mdi_envs/BlockableManipulator-v1`` (and ``-v0``): the paper's time-optimal swing of a
+two-link arm with a motor on the first joint and an impulsive brake on the second.
 """
 
 from __future__ import annotations
@@ -91,7 +91,7 @@ class BlockableManipulatorScene(MoreauJeanScene):
     @staticmethod
     def info_one(q: Any, u: Any, brake: Any, impulses: Any, physics: Any, c: Any,
                  out: Any) -> None:  # fmt: skip
-        """Brake engaged (bound > 0) and its impulse P_B over the last physics step [N m s]."""
+        """Brake engaged (bound > 0) and its impulse P_B summed over the env step [N m s]."""
         out[0] = 1.0 if brake[0] > 0.0 else 0.0
         out[1] = impulses[0]
 
@@ -137,7 +137,9 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
     `reward_objective = -dt` (time-optimal); `reward_shaping = gamma Phi(s') - Phi(s)` with
     `Phi = -shaping_weight d`, `d = sqrt(e_alpha^2 + e_beta^2 + (0.3 s)^2 (alpha'^2 +
     beta'^2))` from the wrapped angle errors, and `Phi = 0` at termination, which leaves the
-    optimal policy unchanged for discount `gamma = shaping_discount`.
+    optimal policy unchanged for discount `gamma = shaping_discount`. With the v1 default
+    `shaping_discount = 1` the shaping sums to `Phi(s_T) - Phi(s_0)` over an episode, so the
+    undiscounted return ranks policies as the episode time does.
 
     ## Starting State
     alpha = beta = 0 at rest, each coordinate and speed plus uniform noise in
@@ -156,7 +158,8 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
     The engaged brake is an equality row (ideal: relative velocity exactly 0 after the step,
     an inelastic impact if it was moving); a finite bound is a Tresca element solved by the
     compiled LCP (enumeration up to 3 unknowns, else Lemke). `info` carries `elapsed_time`
-    [s], `effort` [N^2 m^2 s], `brake_engaged`, `brake_impulse` [N m s], `solver_status`,
+    [s], `effort` [N^2 m^2 s], `brake_engaged`, `brake_impulse` [N m s] (summed over the
+    `frame_skip` physics steps: the whole impact of an engagement), `solver_status`,
     `solver_iterations`, `num_active_contacts`, `distance_to_goal`.
 
     ## Arguments
@@ -169,17 +172,20 @@ class BlockableManipulatorEnv(MoreauJeanEnv):
     | frame_skip        | int   | 2       | physics steps per env step                     |
     | parameters        | BlockableManipulatorParameters | defaults | link masses/lengths |
     | shaping_weight    | float | 1.0     | weight of the shaping potential (0: off)       |
-    | shaping_discount  | float | 0.99    | gamma of the shaping term                      |
+    | shaping_discount  | float | 0.99    | gamma of the shaping term (v1 id: 1.0)         |
     | reset_noise_scale | float | 0.01    | start-state noise half-width [rad, rad/s]      |
     | shortcuts         | StepShortcuts | all on | the stepper's exact shortcuts           |
     | render_mode       | str   | None    | "rgb_array" or "human"                         |
 
-    `gym.make("mdi_envs/BlockableManipulator-v0", action_mode="hybrid")`;
-    `gym.make_vec("mdi_envs/BlockableManipulator-v0", num_envs=1024)` steps all copies in one
+    `gym.make("mdi_envs/BlockableManipulator-v1", action_mode="hybrid")`;
+    `gym.make_vec("mdi_envs/BlockableManipulator-v1", num_envs=1024)` steps all copies in one
     compiled call.
 
     ## Version History
-    * v0: initial release.
+    * v1: `shaping_discount` defaults to 1.0, the setting the shipped baselines train with
+      (with 0.99 the shaping pays for standing still). Dynamics, spaces and the
+      `info["brake_impulse"]` sum over the physics steps are those of v0.
+    * v0: initial release (`shaping_discount` 0.99).
 
     ## References
     K. Yunt, Ch. Glocker, "Modeling and Optimal Control of Hybrid Rigidbody Mechanical

@@ -174,8 +174,8 @@ class BouncingBallEnv(MoreauJeanEnv):
     `eps` = `restitution` (default 0.8) and Coulomb friction `mu` = `friction_coefficient`
     (default 0), gravity 9.81 m/s^2. Moreau-Jean midpoint stepping (``mdi_envs.stepping``),
     `time_step` 1e-3 s, `frame_skip` 10 (env dt 0.01 s), the force held over the substeps.
-    `info` adds `normal_impulse` P_N and `friction_impulse` P_T [N s] of the last physics step
-    (P_N = m g time_step at rest) and `penetration` max(0, r - y) [m], besides
+    `info` adds `normal_impulse` P_N and `friction_impulse` P_T [N s] summed over the env step
+    (P_N = m g dt at rest, dt = time_step * frame_skip) and `penetration` max(0, r - y) [m], besides
     `elapsed_time` [s], `effort` [N^2 s], `distance_to_goal`, `solver_status`,
     `solver_iterations`, `num_active_contacts`.
 

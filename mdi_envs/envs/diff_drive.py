@@ -1,6 +1,6 @@
-"""``mdi_envs/DiffDriveRobot-v0``: the paper's three-wheeled robot driven by two wheel torques
-over stick-slip ground contacts, to a goal pose fastest ("time") or with least effort
-("effort").
+"""``mdi_envs/DiffDriveRobot-v1`` and ``mdi_envs/DiffDriveRobotEffort-v1`` (and
+``DiffDriveRobot-v0``): the paper's three-wheeled robot driven by two wheel torques over
+stick-slip ground contacts, to a goal pose fastest ("time") or with least effort ("effort").
 """
 
 from __future__ import annotations
@@ -106,7 +106,7 @@ class DiffDriveRobotScene(MoreauJeanScene):
     @staticmethod
     def info_one(q: Any, u: Any, brake: Any, impulses: Any, physics: Any, c: Any,
                  out: Any) -> None:  # fmt: skip
-        """Mode (2, 3, 5 DOF), lifted wheels, FC3D residual, normal impulses [N s]."""
+        """Mode (2, 3, 5 DOF), lifted wheels, FC3D residual, normal impulses [N s] (env step)."""
         out[0] = physics[INFO_MODE]
         out[1] = physics[INFO_LIFTED_CONTACTS]
         out[2] = physics[INFO_RESIDUAL]
@@ -125,8 +125,10 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     paper's 2-DOF (both wheels roll), 3-DOF (one slips) and 5-DOF (both slip) modes. The maneuver
     (Yunt & Glocker 2007, section 3.2): from rest at the origin, heading +x, to
     (x, y, phi) = (2 m, 5 m, -pi/2) at rest, wheel angles free.
-    `objective="time"` is maneuver B (time-optimal; paper 4.03 s); `objective="effort"` is
-    maneuver A (minimise the integral of tau_L^2 + tau_R^2 with the final time fixed at 4.05 s).
+    `objective="time"` is maneuver B (time-optimal; paper 4.03 s), the id
+    `mdi_envs/DiffDriveRobot-v1`; `objective="effort"` is maneuver A (minimise the integral of
+    tau_L^2 + tau_R^2 with the final time fixed at 4.05 s), the id
+    `mdi_envs/DiffDriveRobotEffort-v1`.
 
     ## Action Space
     `Box(-1, 1, (2,), float32)`: normalised wheel torques (tau_L, tau_R) / max_wheel_torque.
@@ -169,7 +171,7 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     Alart-Curnier semismooth Newton solve per step, normal impulses from the load-transfer
     balance), time_step 0.01 s, frame_skip 5 (env dt 0.05 s), torques held over the
     substeps. `info`: `slip_mode` (2, 3 or 5), `num_lifted_contacts` (contacts whose load
-    would be negative), `normal_impulse_left/right/stick` [N s] of the last physics step,
+    would be negative), `normal_impulse_left/right/stick` [N s] summed over the env step,
     `elapsed_time` [s], `effort` [N^2 m^2 s], `distance_to_goal`.
 
     ## Arguments
@@ -181,17 +183,25 @@ class DiffDriveRobotEnv(MoreauJeanEnv):
     | frame_skip        | int   | 5       | physics steps per env step                       |
     | parameters        | DiffDriveParameters | defaults | mass, geometry, friction       |
     | shaping_weight    | float | 1.0     | weight of the shaping potential (0: off)         |
-    | shaping_discount  | float | 0.99    | gamma of the shaping term                        |
+    | shaping_discount  | float | 0.99    | gamma of the shaping term (v1 ids: 1.0)          |
     | goal_weight       | float | 10.0    | weight of the final distance ("effort")          |
     | effort_weight     | float | 1.0     | weight of sum tau^2 dt ("effort")                |
     | reset_noise_scale | float | 0.01    | start-state noise half-width                     |
     | render_mode       | str   | None    | "rgb_array" or "human"                           |
 
-    `gym.make("mdi_envs/DiffDriveRobot-v0", objective="effort")`;
-    `gym.make_vec("mdi_envs/DiffDriveRobot-v0", num_envs=256, objective="time")`.
+    The ids set: `DiffDriveRobot-v1` objective "time", shaping_discount 1.0;
+    `DiffDriveRobotEffort-v1` objective "effort", goal_weight 1000, shaping_discount 1.0;
+    `DiffDriveRobot-v0` the defaults above. `gym.make("mdi_envs/DiffDriveRobotEffort-v1")`;
+    `gym.make_vec("mdi_envs/DiffDriveRobot-v1", num_envs=256)`.
 
     ## Version History
-    * v0: initial release.
+    * v1: one id per objective (`DiffDriveRobot-v1`: "time", `DiffDriveRobotEffort-v1`:
+      "effort", goal_weight 1000), `shaping_discount` 1.0: the settings the shipped baselines
+      train with, so that `gym.make(id)` is the task their tables report (rl-zoo3 keys its
+      settings by id). Dynamics and spaces are those of v0; the `normal_impulse_*` info of
+      both versions sums the physics steps of an env step.
+    * v0: initial release: one id, the objective the `objective` argument (default "time"),
+      goal_weight 10, shaping_discount 0.99.
 
     ## References
     K. Yunt, Ch. Glocker, "Modeling and Optimal Control of Hybrid Rigidbody Mechanical

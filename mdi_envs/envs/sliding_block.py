@@ -153,7 +153,7 @@ class SlidingBlockEnv(MoreauJeanEnv):
     slope coordinates. Moreau-Jean midpoint stepping (``mdi_envs.stepping``), `time_step`
     1e-3 s, `frame_skip` 10 (env dt 0.01 s), the force held over the substeps; sticking is
     exact (s' = 0 after a step whose force lies in the cone). `info` adds `normal_impulse`
-    P_N and `friction_impulse` P_T [N s] of the last physics step and `is_sticking` (1.0 if
+    P_N and `friction_impulse` P_T [N s] summed over the env step and `is_sticking` (1.0 if
     P_N > 0 and |s'| <= 1e-6 m/s, else 0.0), besides `elapsed_time` [s], `effort`
     [N^2 s], `distance_to_goal`, `solver_status`, `solver_iterations`,
     `num_active_contacts`.

@@ -270,3 +270,23 @@ def test_unseeded_reset_continues_each_copys_stream_like_sync() -> None:
     np.testing.assert_array_equal(first[0], first[1])
     np.testing.assert_array_equal(second[0], second[1])
     assert not np.array_equal(first[0], second[0])
+
+
+@pytest.mark.parametrize(("env_id", "objective", "shaping_discount", "goal_weight"), [
+    ("mdi_envs/BlockableManipulator-v0", "time", 0.99, 10.0),
+    ("mdi_envs/BlockableManipulator-v1", "time", 1.0, 10.0),
+    ("mdi_envs/DiffDriveRobot-v0", "time", 0.99, 10.0),
+    ("mdi_envs/DiffDriveRobot-v1", "time", 1.0, 10.0),
+    ("mdi_envs/DiffDriveRobotEffort-v1", "effort", 1.0, 1000.0),
+])
+def test_each_id_makes_its_version_of_the_task(env_id: str, objective: str,
+                                               shaping_discount: float,
+                                               goal_weight: float) -> None:  # fmt: skip
+    """The id alone sets the task (single and vector env); arguments still override it."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scenes = [make(env_id).unwrapped.scene, gym.make_vec(env_id, num_envs=2).scene]
+    for scene in scenes:
+        assert (scene.objective, scene.shaping_discount, scene.goal_weight) == (
+            objective, shaping_discount, goal_weight)
+    assert make(env_id, shaping_discount=0.5).unwrapped.scene.shaping_discount == 0.5

@@ -36,6 +36,25 @@ def test_engaged_brake_blocks_the_relative_motion_at_once() -> None:
         assert abs(u[1] - u[0]) <= 1e-12 * (1.0 + np.abs(u).max())
 
 
+def test_brake_impulse_is_the_sum_over_the_physics_steps_of_an_env_step() -> None:
+    """At an engagement the impact falls in the first physics step; the info reports it."""
+    env = make(reset_noise_scale=0.0)
+    env.reset(seed=0)
+    for _ in range(20):
+        env.step(np.array([1.0, -1.0], np.float32))
+    scene = env.unwrapped.scene
+    q, u = env.unwrapped.q, env.unwrapped.u
+    steps = []
+    for _ in range(scene.frame_skip):  # the same physics steps, one at a time
+        result = scene.stepper.step(q, u, [scene.max_torque], [np.inf])
+        q, u = result.q, result.u
+        steps.append(result.impulses[0])
+    info = env.step(np.array([1.0, 1.0], np.float32))[4]
+    np.testing.assert_allclose(env.unwrapped.q, q, rtol=1e-13, atol=1e-13)
+    assert info["brake_impulse"] == pytest.approx(sum(steps), rel=1e-12)
+    assert scene.frame_skip == 2 and abs(steps[0]) > 10.0 * abs(steps[1])  # the impact first
+
+
 def test_hybrid_action_mode_matches_the_box_mode() -> None:
     box, hybrid = make(), make(action_mode="hybrid")
     assert isinstance(hybrid.action_space, gym.spaces.Tuple)
@@ -60,7 +79,7 @@ def test_brake_force_mode_is_a_tresca_element() -> None:
     box = make()
     for env in (released, weak, box):
         env.reset(seed=4)
-    dt = released.unwrapped.scene.stepper.time_step
+    dt = released.unwrapped.dt  # the info sums the impulses of the env step's physics steps
     level = float(np.float32(-0.998))  # the value the float32 action carries
     bound = 0.5 * 50.0 * (level + 1.0)  # 0.05 N m: too weak to hold, the brake slips
     for _ in range(30):
