@@ -95,17 +95,17 @@ class Search:
 
     Attributes:
         env_id: the v1 id. algo: "PPO", "SAC" or "HybridPPO". reference: the optimal
-        reference of the task (``optimal.load_reference``). cost: "time" or "effort", the
-        ratio of the score. timesteps: environment steps per trial. task: the table's task
-        of the entry (its rl-zoo3 file). env_kwargs: ``gym.make`` arguments beyond the id.
+        reference of the maneuver (``optimal.load_reference``). timesteps: environment steps
+        per trial. objective: "time" or "effort", the ratio of the score and the table's
+        objective of the entry (its rl-zoo3 file). env_kwargs: ``gym.make`` arguments beyond
+        the id.
     """
 
     env_id: str
     algo: str
     reference: str
-    cost: str
     timesteps: int
-    task: str = "time"
+    objective: str = "time"
     env_kwargs: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -119,16 +119,14 @@ ROBOT = "mdi_envs/DiffDriveRobot-v1"
 ROBOT_EFFORT = "mdi_envs/DiffDriveRobotEffort-v1"
 _ON_POLICY_STEPS, _OFF_POLICY_STEPS = 500_000, 100_000
 SEARCHES = {search.name: search for search in (
-    Search(MANIPULATOR, "PPO", "manipulator_time", "time", _ON_POLICY_STEPS),
-    Search(MANIPULATOR, "HybridPPO", "manipulator_time", "time", _ON_POLICY_STEPS,
+    Search(MANIPULATOR, "PPO", "manipulator_time", _ON_POLICY_STEPS),
+    Search(MANIPULATOR, "HybridPPO", "manipulator_time", _ON_POLICY_STEPS,
            env_kwargs={"action_mode": "hybrid"}),
-    Search(MANIPULATOR, "SAC", "manipulator_time", "time", _OFF_POLICY_STEPS),
-    Search(ROBOT, "PPO", "diff_drive_time", "time", _ON_POLICY_STEPS),
-    Search(ROBOT, "SAC", "diff_drive_time", "time", _OFF_POLICY_STEPS),
-    Search(ROBOT_EFFORT, "PPO", "diff_drive_effort", "effort", _ON_POLICY_STEPS, "effort",
-           {"task": "effort"}),
-    Search(ROBOT_EFFORT, "SAC", "diff_drive_effort", "effort", _OFF_POLICY_STEPS, "effort",
-           {"task": "effort"}),
+    Search(MANIPULATOR, "SAC", "manipulator_time", _OFF_POLICY_STEPS),
+    Search(ROBOT, "PPO", "diff_drive_time", _ON_POLICY_STEPS),
+    Search(ROBOT, "SAC", "diff_drive_time", _OFF_POLICY_STEPS),
+    Search(ROBOT_EFFORT, "PPO", "diff_drive_effort", _ON_POLICY_STEPS, "effort"),
+    Search(ROBOT_EFFORT, "SAC", "diff_drive_effort", _OFF_POLICY_STEPS, "effort"),
 )}  # fmt: skip
 """The studies by name."""
 
@@ -204,7 +202,7 @@ def optimal_cost(search: Search) -> float:
     from optimal.references import load_reference
 
     reference = load_reference(search.reference)
-    if search.cost == "time":
+    if search.objective == "time":
         return reference.final_time
     return float(np.sum(reference.tau**2) * reference.time_step)
 
@@ -235,7 +233,7 @@ def evaluate_starts(model: Any, search: Search, optimum: float, num_starts: int 
                 finals[i] = infos[i]
     venv.close()
     ends = [final for final in finals if final is not None]
-    key = "elapsed_time" if search.cost == "time" else "effort"
+    key = "elapsed_time" if search.objective == "time" else "effort"
     wins = [final[key] for final in ends if final["is_success"]]
     success_rate = len(wins) / num_starts
     ratio = float(np.mean(wins)) / optimum if wins else None
@@ -268,7 +266,7 @@ def train_and_score(search: Search, algo_kwargs: dict[str, Any], seed: int,
     from baselines.vec_env import make_vec_env
 
     torch.set_num_threads(1)
-    entry = get_hyperparameters(search.env_id, search.algo, search.task)
+    entry = get_hyperparameters(search.env_id, search.algo, search.objective)
     kwargs = {**entry["algo_kwargs"], **algo_kwargs}
     total = search.timesteps if timesteps is None else int(timesteps)
     optimum = optimal_cost(search)
@@ -335,11 +333,11 @@ def load_study(name: str, url: str = DEFAULT_STORAGE) -> Any:
         pruner=optuna.pruners.MedianPruner(n_startup_trials=5, n_warmup_steps=1))
 
 
-def objective(search: Search, timesteps: int | None = None) -> Callable[[Any], float]:
+def make_objective(search: Search, timesteps: int | None = None) -> Callable[[Any], float]:
     """The Optuna objective of ``search``: one training run, scored (module docstring)."""
     import optuna
 
-    from baselines.train import git_commit
+    from mdi_envs.provenance import git_commit
 
     def run(trial: Any) -> float:
         algo_kwargs = SAMPLERS[search.algo](trial)
@@ -372,7 +370,7 @@ def run(name: str, url: str = DEFAULT_STORAGE, n_trials: int | None = None,
 
     study = load_study(name, url)
     finished = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
-    study.optimize(objective(SEARCHES[name], timesteps), n_trials=n_trials, timeout=timeout,
+    study.optimize(make_objective(SEARCHES[name], timesteps), n_trials=n_trials, timeout=timeout,
                    callbacks=[optuna.study.MaxTrialsCallback(NUM_TRIALS, states=finished)],
                    gc_after_trial=True)  # fmt: skip
     return study
@@ -452,7 +450,7 @@ def write_yaml(name: str, url: str = DEFAULT_STORAGE, directory: Path | None = N
     from baselines.hyperparameters import HYPERPARAMS_DIR, hyperparameter_file
 
     search = SEARCHES[name]
-    path = hyperparameter_file(search.algo, search.task)
+    path = hyperparameter_file(search.algo, search.objective)
     if directory is not None:
         path = Path(directory) / path.name
     elif path.parent != HYPERPARAMS_DIR:
@@ -497,6 +495,6 @@ if __name__ == "__main__":
 
 __all__ = [
     "DEFAULT_STORAGE", "NUM_STARTS", "SEARCHES", "START_NOISE", "Search", "best_arguments",
-    "evaluate_starts", "load_study", "objective", "optimal_cost", "plot", "run", "sample_ppo",
+    "evaluate_starts", "load_study", "make_objective", "optimal_cost", "plot", "run", "sample_ppo",
     "sample_sac", "score", "summary", "train_and_score", "write_yaml",
 ]
