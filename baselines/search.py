@@ -334,15 +334,20 @@ def load_study(name: str, url: str = DEFAULT_STORAGE) -> Any:
 
 
 def make_objective(search: Search, timesteps: int | None = None) -> Callable[[Any], float]:
-    """The Optuna objective of ``search``: one training run, scored (module docstring)."""
+    """The Optuna objective of ``search``: one training run, scored (module docstring).
+
+    Every trial records the git commit of the tree at this call (the code the worker runs).
+    """
     import optuna
 
     from mdi_envs.provenance import git_commit
 
+    commit = git_commit()  # of the code this process imported
+
     def run(trial: Any) -> float:
         algo_kwargs = SAMPLERS[search.algo](trial)
         trial.set_user_attr("seed", trial.number)
-        trial.set_user_attr("commit", git_commit())
+        trial.set_user_attr("commit", commit)
 
         def report(index: int, evaluation: dict[str, Any]) -> bool:
             trial.report(evaluation["score"], index)

@@ -16,7 +16,8 @@ TINY = {"n_steps": 64, "batch_size": 64, "n_epochs": 1, "policy_kwargs": {"net_a
 
 def test_grid_crosses_the_table_with_the_seeds() -> None:
     trials = grid(["ppo", "HybridPPO"], [0, 1])
-    assert len(trials) == 4 * 2  # PPO on three env x objectives, HybridPPO on the manipulator
+    # PPO on three env x objectives, HybridPPO on the manipulator; the v0 and the v1 ids
+    assert len(trials) == 2 * 4 * 2
     assert Trial("mdi_envs/DiffDriveRobot-v0", "effort", "PPO", 1) in trials
     assert all(t.stem == run_name(t.env_id, t.objective, t.algo, t.seed) for t in trials)
     assert grid(["SAC"], [3], env_ids=[MANIPULATOR]) == [Trial(MANIPULATOR, "time", "SAC", 3)]
