@@ -5,8 +5,8 @@
 as an instant lock at t_f, or engaged up to t_f), and keeps the best; ``optimal/continuous/
 NAME.json`` holds it. ``solve_level`` solves the h-discrete problem on N intervals started from
 that optimum: its mode sequence on the grid (``pattern_on_grid``, so a lock at t_f is the last
-interval engaged) and its trajectory sampled there, then freed and mode-searched
-(``optimal.refinement.settle``). Levels are independent, so a study is resumable:
+interval engaged) and its trajectory sampled there, then mode-searched. Levels are independent,
+so a study is resumable:
 
     python -m optimal.convergence manipulator_time --levels 30,60,120,240,480
 
@@ -89,12 +89,16 @@ def solve_level(name: str, schedule: SwitchingSchedule, num_intervals: int,
                 max_rounds: int = 8) -> dict[str, Any]:
     """The h-discrete optimum on N intervals, started from the continuous-time ``schedule``.
 
+    The projected pattern is solved with its modes fixed from the sampled trajectory, then
+    mode-searched (``improve_modes``, switches +-1, +-2 intervals per move): the h-discrete
+    optimum on the continuous optimum's branch. (Freed by the continuation instead, as
+    ``optimal.refinement.refine`` does, a coarse grid moves to the branch of an earlier lock.)
+
     Returns:
         A plain-JSON record: N, cost, t_f, converged, the phases [s], the moves of the mode
         search, wall time [s].
     """
-    from optimal.mode_search import solve_with_modes
-    from optimal.refinement import settle
+    from optimal.mode_search import improve_modes, solve_with_modes
     from optimal.transcription import Transcription
 
     clock = time.perf_counter()
@@ -109,7 +113,8 @@ def solve_level(name: str, schedule: SwitchingSchedule, num_intervals: int,
     guess.set_guess(run.q_samples, run.u_samples, _held_inputs(schedule, problem, grid),
                     schedule.final_time)
     fixed = solve_with_modes(problem, pattern, initial=guess.initial_point(), transcription=guess)
-    best, moves = settle(problem, fixed, max_rounds)
+    local = improve_modes(problem, fixed, max_rounds=max_rounds)
+    best, moves = local.best, [step.move for step in local.steps]
     phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
     return {"num_intervals": num_intervals, "cost": best.cost, "final_time": best.final_time,
             "converged": best.success, "start_cost": fixed.cost, "phases": phases,
@@ -204,7 +209,7 @@ def _schedule(data: dict[str, Any]) -> SwitchingSchedule:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m optimal.convergence NAME [--polish] [--levels 30,60,120]``."""
+    """``python -m optimal.convergence NAME [--polish] [--levels 30,60,120]``; prints the table."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("name")
     parser.add_argument("--polish", action="store_true",
@@ -219,11 +224,14 @@ def main(argv: list[str] | None = None) -> None:
               f"s ({100 * record['relative_difference']:+.3f} %)", flush=True)
     levels = [int(n) for n in args.levels.split(",") if n]
     if levels:
-        study = run_study(args.name, levels, max_rounds=args.rounds)
-        for row in study_table(study):
-            print("N = {num_intervals}: {cost:.6f}, d = {distance:.3e} ({relative_distance:.3%})"
-                  ", order {order:.2f}".format(**row))
-
+        run_study(args.name, levels, max_rounds=args.rounds)
+    path = CONTINUOUS_DIR / f"{args.name}_refinement.json"
+    if path.exists():  # the table, as markdown
+        print("| N | t_f [s] | distance [s] | distance / optimum | observed order |\n"
+              "|---|---|---|---|---|")
+        for row in study_table(json.loads(path.read_text())):
+            print("| {num_intervals} | {cost:.6f} | {distance:.3e} | {relative_distance:.3%} | "
+                  "{order:.2f} |".format(**row))
 
 if __name__ == "__main__":
     main()
