@@ -94,11 +94,13 @@ class Search:
     """One study: an algorithm on a v1 env id, with its trial budget.
 
     Attributes:
-        env_id: the v1 id. algo: "PPO", "SAC" or "HybridPPO". reference: the optimal
-        reference of the maneuver (``optimal.load_reference``). timesteps: environment steps
-        per trial. objective: "time" or "effort", the ratio of the score and the table's
-        objective of the entry (its rl-zoo3 file). env_kwargs: ``gym.make`` arguments beyond
-        the id.
+        env_id: the v1 id.
+        algo: "PPO", "SAC" or "HybridPPO".
+        reference: the optimal reference of the maneuver (``optimal.load_reference``).
+        timesteps: environment steps per trial.
+        objective: "time" or "effort", the ratio of the score and the table's objective of
+            the entry (its rl-zoo3 file).
+        env_kwargs: ``gym.make`` arguments beyond the id.
     """
 
     env_id: str

@@ -72,25 +72,33 @@ def class_docstring(entry_point: str) -> str:
 
 
 def env_gif(env_id: str) -> Path | None:
-    """``docs/assets/<Name>-vN.gif``, else the GIF of the same name at another version."""
-    name = env_id.removeprefix(NAMESPACE)
-    exact = ROOT / "docs" / "assets" / f"{name}.gif"
-    if exact.exists():
-        return exact
-    others = sorted((ROOT / "docs" / "assets").glob(f"{name.rsplit('-v', 1)[0]}-v*.gif"))
-    return others[-1] if others else None
+    """``docs/assets/<Name>-vN.gif``, else the GIF of another id with the same entry point."""
+    entry_point = gym.spec(env_id).entry_point
+    same = [env_id] + [i for i in env_ids() if gym.spec(i).entry_point == entry_point]
+    for candidate in same:
+        gif = ROOT / "docs" / "assets" / f"{candidate.removeprefix(NAMESPACE)}.gif"
+        if gif.exists():
+            return gif
+    return None
+
+
+def objective(spec: gym.envs.registration.EnvSpec) -> str:
+    """The objective an id's env optimizes ("time" unless its kwargs say otherwise)."""
+    return str(spec.kwargs.get("objective", "time"))
 
 
 def references_for(env_id: str) -> list[dict[str, Any]]:
-    """The shipped optimal references whose metadata names ``env_id``."""
+    """The shipped references computed for ``env_id``, or for its env class and objective."""
+    spec = gym.spec(env_id)
     rows = []
     for ref_name in available_references():
         meta = load_reference(ref_name).metadata
-        if meta["env_id"] == env_id:
-            rows.append({"reference": f"`{ref_name}`", "objective": meta["cost_kind"],
-                         "t_f [s]": meta["final_time"], "cost": meta["cost"],
-                         "intervals N": meta["num_intervals"], "gym.make kwargs":
-                         f"`{meta['env_kwargs']}`" if meta["env_kwargs"] else ""})
+        ref_spec = gym.spec(meta["env_id"])
+        if meta["env_id"] == env_id or (ref_spec.entry_point == spec.entry_point
+                                        and meta["cost_kind"] == objective(spec)):
+            rows.append({"reference": f"`{ref_name}`", "computed for": f"`{meta['env_id']}`",
+                         "objective": meta["cost_kind"], "t_f [s]": meta["final_time"],
+                         "cost": meta["cost"], "intervals N": meta["num_intervals"]})
     return rows
 
 
