@@ -25,9 +25,11 @@ from __future__ import annotations
 import contextlib
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
+
+from baselines.records import Estimate
 
 BOOTSTRAP_REPS = 2000
 """Bootstrap replications per interval estimate."""
@@ -58,7 +60,7 @@ def _iqm(scores: np.ndarray) -> np.ndarray:
 
 
 def iqm_interval(values: Sequence[float | None], reps: int = BOOTSTRAP_REPS, seed: int = 0
-                 ) -> dict[str, Any]:  # fmt: skip
+                 ) -> Estimate:  # fmt: skip
     """The IQM over runs and its 95 % stratified-bootstrap CI.
 
     Args:
@@ -67,24 +69,23 @@ def iqm_interval(values: Sequence[float | None], reps: int = BOOTSTRAP_REPS, see
         reps: bootstrap replications. seed: the resampling's seed.
 
     Returns:
-        {"n": runs with a score, "missing": runs without, "iqm": float or None (no run),
-        "ci": [low, high] or None (fewer than 2 runs), "values": the scores}.
+        The ``Estimate``: ``mean`` and ``iqm`` None without a run, ``ci`` None with fewer
+        than 2 or ``reps`` 0.
     """
     from rliable import library
 
     scores = [float(v) for v in values if v is not None and np.isfinite(v)]
-    result: dict[str, Any] = {"n": len(scores), "missing": len(values) - len(scores),
-                              "iqm": None, "ci": None, "values": scores}  # fmt: skip
-    if not scores:
-        return result
-    matrix = np.asarray(scores)[:, None]  # (runs, 1 task)
-    result["iqm"] = float(_iqm(matrix)[0])
-    if len(scores) >= 2:
+    iqm, ci = None, None
+    if scores:
+        matrix = np.asarray(scores)[:, None]  # (runs, 1 task)
+        iqm = float(_iqm(matrix)[0])
+    if len(scores) >= 2 and reps > 0:
         with _seeded(seed):
             _, intervals = library.get_interval_estimates(
                 {"runs": matrix}, _iqm, reps=reps, confidence_interval_size=CONFIDENCE)
-        result["ci"] = [float(intervals["runs"][0, 0]), float(intervals["runs"][1, 0])]
-    return result
+        ci = (float(intervals["runs"][0, 0]), float(intervals["runs"][1, 0]))
+    mean = float(np.mean(scores)) if scores else None
+    return Estimate(len(scores), len(values) - len(scores), mean, iqm, ci, scores)
 
 
 def performance_profiles(scores: Mapping[str, Sequence[float]], taus: np.ndarray,
@@ -159,29 +160,40 @@ def sampled_curve(steps: np.ndarray, success: np.ndarray, num_points: int = CURV
     return grid, success_curve(steps, success, grid, window)
 
 
+@dataclass(frozen=True)
+class Curve:
+    """IQM over runs of a training curve: steps (G,), iqm (G,), ci (2, G) or None, n runs."""
+
+    steps: np.ndarray
+    iqm: np.ndarray
+    ci: np.ndarray | None
+    n: int
+
+
 def training_curves(runs: Mapping[str, Sequence[tuple[np.ndarray, np.ndarray]]],
                     num_points: int = 40, reps: int = BOOTSTRAP_REPS, seed: int = 0
-                    ) -> dict[str, dict[str, Any]]:  # fmt: skip
+                    ) -> dict[str, Curve]:  # fmt: skip
     """IQM and 95 % CI over runs of the training success rate, per label.
 
     Args:
         runs: label -> one curve (steps (P,), success rate (P,)) per run (``sampled_curve``,
             ascending steps), interpolated linearly onto the common grid.
-        num_points: grid points from the latest first step to the shortest run's last step.
+        num_points: grid points, evenly spaced in log(steps), from the latest first step to
+            the shortest run's last step.
         reps: bootstrap replications. seed: the resampling's seed.
 
     Returns:
-        label -> {"steps": (G,), "iqm": (G,), "ci": (2, G) or None (one run), "n": runs}.
+        label -> its ``Curve`` (``ci`` None for one run).
     """
     from rliable import library
 
-    curves: dict[str, dict[str, Any]] = {}
+    curves: dict[str, Curve] = {}
     for label, logs in runs.items():
         logs = [(np.asarray(s, float), np.asarray(r, float)) for s, r in logs if len(s)]
         if not logs:
             continue
         end = min(float(steps[-1]) for steps, _ in logs)
-        grid = np.linspace(max(float(steps[0]) for steps, _ in logs), end, num_points)
+        grid = np.geomspace(max(1.0, max(float(steps[0]) for steps, _ in logs)), end, num_points)
         matrix = np.stack([np.interp(grid, s, r) for s, r in logs])[:, None, :]  # (R, 1, G)
 
         def per_point(scores: np.ndarray) -> np.ndarray:
@@ -197,11 +209,11 @@ def training_curves(runs: Mapping[str, Sequence[tuple[np.ndarray, np.ndarray]]],
                 _, intervals = library.get_interval_estimates(
                     {label: matrix}, per_point, reps=reps, confidence_interval_size=CONFIDENCE)
             interval = intervals[label]
-        curves[label] = {"steps": grid, "iqm": point, "ci": interval, "n": len(logs)}
+        curves[label] = Curve(grid, point, interval, len(logs))
     return curves
 
 
 __all__ = [
-    "BOOTSTRAP_REPS", "CONFIDENCE", "CURVE_POINTS", "iqm_interval", "performance_profiles",
+    "BOOTSTRAP_REPS", "CONFIDENCE", "CURVE_POINTS", "Curve", "iqm_interval", "performance_profiles",
     "sampled_curve", "success_curve", "training_curves",
 ]

@@ -1,4 +1,4 @@
-"""The baselines' subcommands: ``simulate``, ``demo``, ``train``, ``compare`` and ``sweep``.
+"""The baselines' subcommands: simulate, demo, train, sweep, compare and robustness.
 
 Each ``add_*_parser`` is registered in ``pyproject.toml`` as a ``mdi_envs.commands`` entry
 point (the plug-in interface is in ``mdi_envs/cli.py``); each parser's handler is its ``run_*``
@@ -17,7 +17,14 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+from baselines.records import DEFAULT_SCALE
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from baselines.records import Condition, Study
 
 
 def add_train_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -79,70 +86,119 @@ def run_train(args: argparse.Namespace) -> int:
     return 0
 
 
+def _study_arguments(parser: argparse.ArgumentParser, scales: list[float],
+                     output: str) -> None:  # fmt: skip
+    """The arguments ``compare`` and ``robustness`` share."""
+    from baselines.evaluation import OBJECTIVES
+
+    parser.add_argument("env_id", choices=[*sorted(OBJECTIVES), "all"], help="the environment")
+    parser.add_argument("--objective", choices=("time", "effort"), default=None,
+                        help="one objective (default: every objective of the env)")
+    parser.add_argument("--seeds", type=int, default=20,
+                        help="perturbed starts per run (per training seed and controller)")
+    parser.add_argument("--scales", type=float, nargs="*", default=scales,
+                        help=f"start perturbation scales [rad, rad/s, m, m/s] (default "
+                        f"{' '.join(map(str, scales))}; none: play no scale)")
+    parser.add_argument("--trained", type=Path, default=None,
+                        help="folder of the trained policies (default: baselines/trained; e.g. "
+                        "the output of mdi-envs sweep)")
+    parser.add_argument("--mpc", action="store_true",
+                        help="also play the shrinking-horizon MPC around the reference "
+                        "(optimal.mpc; needs CasADi; 0.1-1 s of compute per env step)")
+    parser.add_argument("--controllers", nargs="+", default=None, metavar="LABEL",
+                        help="play only these rows (labels as in the table, e.g. PPO HybridPPO "
+                        "'MPC (shrinking horizon)') and merge them into the study already in "
+                        "--output, keeping its other rows")
+    parser.add_argument("--output", type=Path, default=Path(output),
+                        help="folder for the JSON, PNG and Markdown results")
+    parser.add_argument("--resume", action="store_true",
+                        help="reuse the episodes already in OUTPUT/episodes.jsonl (every "
+                        "finished episode is appended there): an interrupted run goes on")
+
+
 def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Add the ``compare`` subcommand to an argparse subparsers object; returns its parser."""
-    from baselines.compare import OBJECTIVES
-
     parser = subparsers.add_parser(
         "compare",
         help="trained RL policies (every seed) vs the optimal reference: IQM and CIs of success, "
         "time and effort ratios",
         description="Play every trained policy of ENV_ID (--trained, default baselines/trained: "
         "one STEM.json + STEM.zip per training seed) and the untrained controllers (the optimal "
-        "reference, open loop) from the nominal start and from --seeds perturbed starts; print "
-        "per algorithm the IQM and 95 % stratified-bootstrap CI over its seeds (rliable) of the "
-        "success rate and of the time/effort ratios to the optimum as a Markdown table; write "
-        "compare_ENV_TASK.json and .png (trajectories, brake schedules / slip modes, scores), "
-        "seeds_ENV_TASK.png (performance profiles, training curves with CI bands from the "
-        "STEM_episodes.csv files) and compare.md into --output. ENV_ID 'all' runs both mission "
-        "envs, every objective.",
+        "reference, open loop) from the nominal start and from --seeds perturbed starts at each "
+        "--scales; print per algorithm the IQM and 95 % stratified-bootstrap CI over its seeds "
+        "(rliable) of the success rate and of the time/effort ratios to the optimum as a "
+        "Markdown table; write compare_ENV_OBJECTIVE.json, .md and .png (trajectories, brake "
+        "schedules / slip modes, scores), seeds_ENV_OBJECTIVE.png (performance profiles, training "
+        "curves) and compare.md into --output (figures of a scale other than 0.01 end in "
+        "_scaleS). ENV_ID 'all' runs both mission envs, every objective.",
     )
-    parser.add_argument("env_id", choices=[*sorted(OBJECTIVES), "all"], help="the environment")
-    parser.add_argument("--objective", choices=("time", "effort"), default=None,
-                        help="one objective (default: every objective of the env)")
-    parser.add_argument("--seeds", type=int, default=20,
-                        help="perturbed starts per run (per training seed and controller)")
-    parser.add_argument("--trained", type=Path, default=None,
-                        help="folder of the trained policies (default: baselines/trained; e.g. "
-                        "the output of mdi-envs sweep)")
+    _study_arguments(parser, [DEFAULT_SCALE], "results/compare")
     parser.add_argument("--bootstrap-reps", type=int, default=None,
                         help="bootstrap replications per CI (default 2000)")
-    parser.add_argument("--mpc", action="store_true",
-                        help="also play the shrinking-horizon MPC around the reference "
-                        "(optimal.mpc; needs CasADi; 0.1-1 s of compute per env step)")
-    parser.add_argument("--controllers", nargs="+", default=None, metavar="LABEL",
-                        help="play only these rows (labels as in the table, e.g. PPO HybridPPO "
-                        "'MPC (shrinking horizon)') and merge them into the comparison JSON "
-                        "already in --output, keeping its other rows")
-    parser.add_argument("--output", type=Path, default=Path("results/compare"),
-                        help="folder for the JSON, PNG and Markdown results")
     parser.set_defaults(handler=run_compare)
     return parser
 
 
-def run_compare(args: argparse.Namespace) -> int:
-    """Handler of ``compare``: runs each env x objective, prints and writes the table; returns 0."""
-    import json
+ROBUSTNESS = ("Play every controller (the optimal reference open loop, --mpc, every trained "
+              "seed) from --seeds perturbed starts at each of --scales and, at the default "
+              "scale, under each model mismatch in the env only (link masses +-10 %; robot "
+              "mass +-10 %, friction +-20 %); write robustness_ENV_OBJECTIVE.json and .png and "
+              "robustness.md (success, mean over runs, and the time or effort ratio over the "
+              "successes) into --output.")
+"""The description of ``robustness`` (also ``python -m baselines.robustness``)."""
+
+
+def add_robustness_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``robustness`` subcommand to an argparse subparsers object; returns its parser."""
+    parser = subparsers.add_parser(
+        "robustness",
+        help="every controller under larger start perturbations and model mismatches",
+        description=ROBUSTNESS,
+    )
+    robustness_arguments(parser)
+    parser.set_defaults(handler=run_robustness)
+    return parser
+
+
+def robustness_arguments(parser: argparse.ArgumentParser) -> None:
+    """The arguments of ``robustness`` (also ``python -m baselines.robustness``)."""
+    from baselines.evaluation import SCALES
+
+    _study_arguments(parser, list(SCALES), "results/robustness")
+    parser.add_argument("--mismatch", action=argparse.BooleanOptionalAction, default=True,
+                        help="also play the model mismatches (default: yes)")
+    parser.add_argument("--mismatches", nargs="+", default=None, metavar="LABEL",
+                        help="play only these model mismatches (labels as in the table)")
+
+
+def _studies(args: argparse.Namespace, prefix: str, nominal: bool,
+             conditions: Callable[[str], list[Condition]]) -> list[Study]:  # fmt: skip
+    """Play each env x objective of ``args`` and write ``{prefix}_ENV_OBJECTIVE.json``; the studies.
+
+    With ``--controllers`` the study merges into the one in the folder. ``nominal`` (the
+    comparison): also the nominal starts, and bootstrap intervals in the aggregates.
+    """
     import sys
 
-    from baselines.compare import (
-        OBJECTIVES,
+    from baselines.evaluation import (
+        REFERENCE_NAMES,
         TRAINED_DIR,
-        collect_tables,
-        compare,
-        merge_comparisons,
+        aggregate,
+        evaluate,
+        merge,
         shipped_algorithms,
-        write_comparison,
     )
+    from baselines.records import read_study, write_study
 
     if args.seeds < 1:
-        raise SystemExit(f"compare: --seeds must be >= 1, got {args.seeds}")
-    env_ids = sorted(OBJECTIVES) if args.env_id == "all" else [args.env_id]
-    jobs = [(env_id, objective) for env_id in env_ids for objective in OBJECTIVES[env_id]
-            if args.objective in (None, objective)]  # fmt: skip
+        raise SystemExit(f"{prefix}: --seeds must be >= 1, got {args.seeds}")
+    jobs = [key for key in REFERENCE_NAMES
+            if args.env_id in ("all", key[0]) and args.objective in (None, key[1])]
     if not jobs:
-        raise SystemExit(f"compare: {args.env_id} has no objective {args.objective!r}")
+        raise SystemExit(f"{prefix}: {args.env_id} has no objective {args.objective!r}")
     trained_dir = TRAINED_DIR if args.trained is None else args.trained
+    args.output.mkdir(parents=True, exist_ok=True)
+    studies = []
     for env_id, objective in jobs:
         extra = []
         if args.mpc:
@@ -150,23 +206,68 @@ def run_compare(args: argparse.Namespace) -> int:
 
             controller = mpc_controller(env_id, objective)
             if controller is None:
-                raise SystemExit("compare: --mpc needs CasADi (pip install 'mdi-envs[optimal]')")
+                raise SystemExit(f"{prefix}: --mpc needs CasADi (pip install "
+                                 "'mdi-envs[optimal]')")
             extra.append(controller)
         try:
-            comparison = compare(env_id, objective, num_seeds=args.seeds, trained_dir=trained_dir,
-                                 bootstrap_reps=args.bootstrap_reps, extra_controllers=extra,
-                                 log=lambda line: print(line, file=sys.stderr, flush=True),
-                                 only=args.controllers)
+            study = evaluate(env_id, objective, conditions(env_id), args.seeds,
+                             trained_dir=trained_dir, extra_controllers=extra,
+                             only=args.controllers, nominal=nominal,
+                             log_path=args.output / "episodes.jsonl", resume=args.resume,
+                             show_bar=sys.stderr.isatty())  # fmt: skip
         except ValueError as error:
-            raise SystemExit(f"compare: {error}") from error
-        previous = args.output / f"compare_{env_id.split('/')[-1]}_{objective}.json"
-        if args.controllers is not None and previous.exists():
-            comparison = merge_comparisons(json.loads(previous.read_text()), comparison,
-                                           shipped_algorithms(env_id, objective, trained_dir))
-        for path in write_comparison(comparison, args.output, trained_dir):
-            print(f"wrote {path}", file=sys.stderr)
-    table = collect_tables(args.output)
+            raise SystemExit(f"{prefix}: {error}") from error
+        path = args.output / f"{prefix}_{study.name}.json"
+        if args.controllers is not None and path.exists():
+            shipped = shipped_algorithms(env_id, objective, trained_dir)
+            study = merge(read_study(path), study, shipped)
+        study = aggregate(study, args.bootstrap_reps if nominal else 0)
+        studies.append(study)
+        print(f"wrote {write_study(study, path)}", file=sys.stderr)
+    return studies
+
+
+def run_compare(args: argparse.Namespace) -> int:
+    """Handler of ``compare``: plays each env x objective, writes the study, figures and tables."""
+    from baselines.evaluation import TRAINED_DIR
+    from baselines.plots import plot_comparison, plot_seeds
+    from baselines.records import Condition, read_study
+    from baselines.tables import comparison_table
+
+    studies = _studies(args, "compare", True, lambda _: [Condition(s) for s in args.scales])
+    trained_dir = args.trained or TRAINED_DIR
+    for study in studies:  # the figures of the scales played now
+        for condition in map(Condition, args.scales):
+            tail = "" if condition.scale == DEFAULT_SCALE else f"_scale{condition.scale:g}"
+            plot_comparison(study, args.output / f"compare_{study.name}{tail}.png",
+                            condition.label)  # fmt: skip
+            plot_seeds(study, args.output / f"seeds_{study.name}{tail}.png", trained_dir,
+                       condition.label, args.bootstrap_reps)  # fmt: skip
+        (args.output / f"compare_{study.name}.md").write_text(comparison_table([study]) + "\n")
+    everything = [read_study(path) for path in sorted(args.output.glob("compare_*.json"))]
+    table = comparison_table(everything)
     (args.output / "compare.md").write_text(table + "\n")
+    print(table)
+    return 0
+
+
+def run_robustness(args: argparse.Namespace) -> int:
+    """Handler of ``robustness``: plays each env x objective, writes the study, figure and table."""
+    from baselines.evaluation import MISMATCHES
+    from baselines.plots import plot_robustness
+    from baselines.records import Condition, read_study
+    from baselines.tables import robustness_table
+
+    def conditions(env_id: str) -> list[Condition]:
+        labels = list(MISMATCHES[env_id]) if args.mismatches is None else args.mismatches
+        return [Condition(scale) for scale in args.scales] + [
+            Condition(DEFAULT_SCALE, label) for label in labels if args.mismatch]
+
+    for study in _studies(args, "robustness", False, conditions):
+        plot_robustness(study, args.output / f"robustness_{study.name}.png")
+    studies = [read_study(path) for path in sorted(args.output.glob("robustness_*.json"))]
+    table = robustness_table(studies)
+    (args.output / "robustness.md").write_text(table + "\n")
     print(table)
     return 0
 
@@ -337,6 +438,7 @@ def run_demo(args: argparse.Namespace) -> int:
 
 
 __all__ = [
-    "add_compare_parser", "add_demo_parser", "add_simulate_parser", "add_sweep_parser",
-    "add_train_parser", "run_compare", "run_demo", "run_simulate", "run_sweep", "run_train",
+    "add_compare_parser", "add_demo_parser", "add_robustness_parser", "add_simulate_parser",
+    "add_sweep_parser", "add_train_parser", "robustness_arguments", "run_compare", "run_demo",
+    "run_robustness", "run_simulate", "run_sweep", "run_train",
 ]

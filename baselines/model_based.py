@@ -5,7 +5,7 @@ id, objective) in the env configured like the reference's open-loop replay (one 
 transcription interval, ``env_options``), with twice the reference's steps for time-optimal
 objectives (a perturbed start may need longer than the optimum; the effort objectives keep their
 fixed horizon). One controller serves every episode of a row, so the NLPs it built are reused.
-``mdi-envs compare ... --mpc`` adds it; it is not in ``baselines.compare.CONTROLLER_FACTORIES``,
+``mdi-envs compare ... --mpc`` adds it; it is not in ``baselines.evaluation.CONTROLLER_FACTORIES``,
 which every comparison and test plays, because it costs 0.1-1 s of compute per env step. Needs
 CasADi (the ``optimal`` extra); without it the row is left out.
 """
@@ -15,7 +15,7 @@ from __future__ import annotations
 import importlib.util
 from typing import Any
 
-from baselines.compare import REFERENCE_NAMES, Controller
+from baselines.evaluation import REFERENCE_NAMES, Controller
 from optimal.references import load_reference
 from optimal.replay import env_options
 

@@ -13,7 +13,7 @@ checks the single env (Gymnasium's and SB3's ``check_env``), builds the batched 
   package versions, git commit, wall time, training and evaluation scores;
 - ``STEM_episodes.csv``: one row per finished training episode (timesteps, return, length,
   success, elapsed time [s], effort [N^2 m^2 s]); large, kept local;
-- ``STEM_curve.csv``: the compact training curve shipped with a policy (``write_curve``: the
+- ``STEM_curve.csv``: the compact training curve shipped with a policy (``write_logs``: the
   success rate over the last 100 episodes at 200 steps), from which the seed plots draw their
   bands;
 - ``STEM.png``: episode return and success rate vs environment steps;
@@ -30,7 +30,6 @@ The algorithm names and their classes are in ``baselines.hyperparameters`` (``AL
 from __future__ import annotations
 
 import copy
-import csv
 import importlib
 import json
 import platform
@@ -200,8 +199,7 @@ def train(
     venv.close()
 
     evaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed=seed + 10_000)
-    write_episodes(log.rows, output / f"{stem}_episodes.csv")
-    write_curve(log.rows, output / f"{stem}_curve.csv")
+    write_logs(log.rows, output / f"{stem}_episodes.csv", output / f"{stem}_curve.csv")
     recent = log.rows[-100:]
     config = {
         "env_id": env_id, "objective": objective, "algo": algo, "seed": seed,
@@ -224,6 +222,8 @@ def train(
                    + (" (plus algo_overrides)" if algo_overrides else ""),
     }
     (output / f"{stem}.json").write_text(json.dumps(config, indent=2, default=str) + "\n")
+    from baselines.plots import plot_training
+
     plot_training(log.rows, output / f"{stem}.png", title=f"{stem} ({algo}, {num_envs} envs)")
     return model_path
 
@@ -266,74 +266,22 @@ def evaluate(model: Any, env_id: str, env_kwargs: dict[str, Any], episodes: int,
     return result
 
 
-def write_episodes(rows: list[tuple[Any, ...]], path: Path) -> None:
-    """Write the episode log as CSV with ``EPISODE_COLUMNS``."""
-    with path.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(EPISODE_COLUMNS)
-        writer.writerows(rows)
+def write_logs(rows: list[tuple[Any, ...]], episodes_path: Path, curve_path: Path) -> None:
+    """Write the episode log (``EPISODE_COLUMNS``) and its compact training curve as CSV.
 
+    The curve (``baselines.aggregate.sampled_curve``): timesteps, success_rate (moving mean
+    over the last 100 episodes) at 200 steps.
+    """
+    import pandas as pd
 
-def training_curve(rows: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray]:
-    """(steps (P,), success rate (P,)) of an episode log (``baselines.aggregate.sampled_curve``)."""
     from baselines.aggregate import sampled_curve
 
-    return sampled_curve(np.array([r[0] for r in rows], dtype=float),
-                         np.array([r[3] for r in rows], dtype=float))
-
-
-def write_curve(rows: list[tuple[Any, ...]], path: Path) -> None:
-    """Write the compact training curve (``training_curve``) as CSV.
-
-    Columns: timesteps, success_rate (moving mean over the last 100 episodes).
-    """
-    steps, rates = training_curve(rows)
-    with path.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(("timesteps", "success_rate"))
-        writer.writerows((int(step), f"{rate:.4f}") for step, rate in zip(steps, rates,
-                                                                           strict=True))
-
-
-def read_episodes(path: Path) -> list[tuple[Any, ...]]:
-    """The rows of a ``STEM_episodes.csv`` (``EPISODE_COLUMNS``, typed as written)."""
-    with Path(path).open() as handle:
-        return [(int(float(r["timesteps"])), float(r["return"]), int(float(r["length"])),
-                 r["is_success"] == "True", float(r["elapsed_time"]), float(r["effort"]))
-                for r in csv.DictReader(handle)]
-
-
-def plot_training(rows: list[tuple[Any, ...]], path: Path, title: str = "",
-                  window: int = 100) -> None:  # fmt: skip
-    """Episode return and success rate vs environment steps (moving mean over ``window``)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (ax_return, ax_success) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
-    if rows:
-        data = np.array([r[:4] for r in rows], dtype=float)
-        steps, returns, success = data[:, 0], data[:, 1], data[:, 3]
-        kernel = np.ones(min(window, len(rows)))
-        counts = np.convolve(np.ones(len(rows)), kernel)[: len(rows)]
-        ax_return.plot(steps, returns, ".", ms=2, alpha=0.3, color="C0", label="episode")
-        ax_return.plot(steps, np.convolve(returns, kernel)[: len(rows)] / counts, color="C0",
-                       label=f"mean of last {len(kernel)}")  # fmt: skip
-        ax_success.plot(steps, np.convolve(success, kernel)[: len(rows)] / counts, color="C2")
-    else:
-        ax_return.text(0.5, 0.5, "no finished episode", ha="center", transform=ax_return.transAxes)
-    ax_return.set_ylabel("episode return [-]")
-    ax_return.legend(loc="lower right") if rows else None
-    ax_success.set_ylabel("success rate")
-    ax_success.set_ylim(-0.05, 1.05)
-    ax_success.set_xlabel("environment steps")
-    for ax in (ax_return, ax_success):
-        ax.grid(alpha=0.3)
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    episodes = pd.DataFrame(rows, columns=list(EPISODE_COLUMNS))
+    episodes.to_csv(episodes_path, index=False)
+    steps, rates = sampled_curve(episodes["timesteps"].to_numpy(float),
+                                 episodes["is_success"].to_numpy(float))
+    pd.DataFrame({"timesteps": steps.astype(int), "success_rate": rates}).to_csv(
+        curve_path, index=False, float_format="%.4f")
 
 
 def versions() -> dict[str, str]:
@@ -348,6 +296,5 @@ def versions() -> dict[str, str]:
 
 __all__ = [
     "EpisodeLog", "algorithm_class", "check_single_env", "evaluate", "load_trained",
-    "plot_training", "read_episodes", "run_name", "train", "training_curve", "write_curve",
-    "write_episodes",
+    "run_name", "train", "write_logs",
 ]

@@ -25,7 +25,8 @@ import mkdocs_gen_files
 import pandas as pd
 
 import mdi_envs  # noqa: F401  (registers the ids)
-from baselines import robustness
+from baselines.records import read_study
+from baselines.tables import robustness_table
 from optimal import available_references, load_reference
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -285,13 +286,13 @@ def trained_rows() -> list[dict[str, Any]]:
 def robustness_page() -> None:
     """``results/robustness.md``: success and ratio under perturbations and model mismatch."""
     folder = ROOT / "baselines" / "robustness"
-    studies = [load(p) for p in sorted(folder.glob("robustness_*.json"))]
+    studies = [read_study(p) for p in sorted(folder.glob("robustness_*.json"))]
     lines = ["# Robustness", "",
              "Generated from `baselines/robustness/robustness_*.json` (written by "
              "`python -m baselines.robustness all --output baselines/robustness`; every episode "
              "is in `episodes.jsonl`). Each cell: success over 20 starts per run, and in "
              "brackets the time (or effort) over the optimum, over the successes.", "",
-             robustness.markdown_table(studies), ""]
+             robustness_table(studies), ""]
     for png in sorted(folder.glob("*.png")):
         lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
     write("results/robustness.md", "\n".join(lines))

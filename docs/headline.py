@@ -7,56 +7,60 @@ The numbers come from ``baselines/comparison/compare_*.json`` (``mdi-envs compar
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
+
+from baselines.records import Estimate, Row, Study, read_study
 
 ROOT = Path(__file__).resolve().parent.parent
 COMPARISON_DIR = ROOT / "baselines" / "comparison"
 PLOT = ROOT / "docs" / "assets" / "headline.png"
 
 
-def comparisons(folder: Path = COMPARISON_DIR) -> list[dict[str, Any]]:
+def comparisons(folder: Path = COMPARISON_DIR) -> list[Study]:
     """Every committed ``compare_*.json``, sorted by env and objective."""
-    return [json.loads(p.read_text()) for p in sorted(folder.glob("compare_*.json"))]
+    return [read_study(p) for p in sorted(folder.glob("compare_*.json"))]
 
 
-def _interval(estimate: dict[str, Any], percent: bool) -> str:
+def _scores(study: Study, row: Row) -> tuple[Estimate, Estimate]:
+    """A row's success and time or effort ratio at the study's first (nominal) condition."""
+    aggregate = row.aggregate(study.conditions[0].label)
+    assert aggregate is not None, f"{study.name} {row.label}: no aggregate"
+    return aggregate.success_rate, getattr(aggregate, f"{study.objective}_ratio")
+
+
+def _interval(estimate: Estimate, percent: bool) -> str:
     """"IQM [low, high]", the value alone without a CI, or "-" without any score."""
-    if estimate["iqm"] is None:
+    if estimate.iqm is None:
         return "-"
     show = (lambda v: f"{100 * v:.0f} %") if percent else (lambda v: f"{v:.2f}")
-    some = f" ({estimate['n']} of {estimate['n'] + estimate['missing']} runs)" \
-        if estimate.get("missing") else ""
-    if estimate.get("ci") is None:
-        return show(estimate["iqm"]) + some
-    low, high = estimate["ci"]
-    return f"{show(estimate['iqm'])} [{show(low)}, {show(high)}]{some}"
+    some = f" ({estimate.n} of {estimate.n + estimate.missing} runs)" if estimate.missing else ""
+    if estimate.ci is None:
+        return show(estimate.iqm) + some
+    low, high = estimate.ci
+    return f"{show(estimate.iqm)} [{show(low)}, {show(high)}]{some}"
 
 
-def headline_frame(runs: list[dict[str, Any]]) -> pd.DataFrame:
+def headline_frame(runs: list[Study]) -> pd.DataFrame:
     """One row per env x objective x controller: success and ratio to the optimum, IQM [CI]."""
     rows = []
-    for run in runs:
-        objective = run["objective"]
-        for row in run["controllers"]:
-            aggregate = row["aggregate"]
+    for study in runs:
+        for row in study.rows:
+            success, ratio = _scores(study, row)
             rows.append({
-                "env": run["env_id"].removeprefix("mdi_envs/"),
-                "objective": objective,
-                "controller": row["label"],
-                "runs": len(row["runs"]),
-                "success": _interval(aggregate["success_rate"], percent=True),
-                "time or effort / optimal": _interval(aggregate[f"{objective}_ratio"],
-                                                      percent=False),
+                "env": study.env_id.removeprefix("mdi_envs/"),
+                "objective": study.objective,
+                "controller": row.label,
+                "runs": success.n,
+                "success": _interval(success, percent=True),
+                "time or effort / optimal": _interval(ratio, percent=False),
             })
     return pd.DataFrame(rows)
 
 
-def headline_plot(runs: list[dict[str, Any]], path: Path = PLOT) -> Path:
+def headline_plot(runs: list[Study], path: Path = PLOT) -> Path:
     """Success (bars) and ratio to the optimum (dots) per controller, one panel per objective."""
     import matplotlib
 
@@ -65,20 +69,20 @@ def headline_plot(runs: list[dict[str, Any]], path: Path = PLOT) -> Path:
 
     fig, axes = plt.subplots(1, len(runs), figsize=(4.2 * len(runs), 3.4), squeeze=False)
     for ax, run in zip(axes[0], runs, strict=True):
-        labels = [row["label"].replace(" (shrinking horizon)", "").replace(" (open loop)",
-                                                                           "\n(open loop)")
-                  for row in run["controllers"]]
-        success = [row["aggregate"]["success_rate"] for row in run["controllers"]]
-        ratio = [row["aggregate"][f"{run['objective']}_ratio"] for row in run["controllers"]]
+        labels = [row.label.replace(" (shrinking horizon)", "").replace(" (open loop)",
+                                                                        "\n(open loop)")
+                  for row in run.rows]
+        success, ratio = (list(scores) for scores in
+                          zip(*(_scores(run, row) for row in run.rows), strict=True))
         x = range(len(labels))
-        ax.bar(x, [s["iqm"] for s in success], color="tab:green", alpha=0.8,
+        ax.bar(x, [s.iqm for s in success], color="tab:green", alpha=0.8,
                yerr=_errors(success), capsize=3, label="success (IQM, 95 % CI)")
         ax.set_ylim(0, 1.05)
         ax.set_xticks(list(x), labels, fontsize=7)
-        ax.set_title(f"{run['env_id'].removeprefix('mdi_envs/')}, {run['objective']}", fontsize=9)
+        ax.set_title(f"{run.env_id.removeprefix('mdi_envs/')}, {run.objective}", fontsize=9)
         twin = ax.twinx()
-        shown = [i for i, r in enumerate(ratio) if r["iqm"] is not None]
-        twin.errorbar(shown, [ratio[i]["iqm"] for i in shown],
+        shown = [i for i, r in enumerate(ratio) if r.iqm is not None]
+        twin.errorbar(shown, [ratio[i].iqm for i in shown],
                       yerr=_errors([ratio[i] for i in shown]), fmt="o", color="black",
                       capsize=3, label="time or effort / optimal")
         twin.axhline(1.0, color="gray", lw=0.8, ls=":")
@@ -96,13 +100,14 @@ def headline_plot(runs: list[dict[str, Any]], path: Path = PLOT) -> Path:
     return path
 
 
-def _errors(estimates: list[dict[str, Any]]) -> list[list[float]]:
+def _errors(estimates: list[Estimate]) -> list[list[float]]:
     """Asymmetric error bars (2, k) from IQM and CI (zero without a CI)."""
     low, high = [], []
     for e in estimates:
-        ci = e.get("ci") or [e["iqm"], e["iqm"]]
-        low.append(e["iqm"] - ci[0])
-        high.append(ci[1] - e["iqm"])
+        iqm = e.iqm or 0.0
+        ci = e.ci or (iqm, iqm)
+        low.append(iqm - ci[0])
+        high.append(ci[1] - iqm)
     return [low, high]
 
 

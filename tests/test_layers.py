@@ -37,11 +37,7 @@ def import_cycles(*packages: str) -> list[list[str]]:
 
 
 # A cycle across packages would break the layer contract, so each package is checked alone.
-@pytest.mark.parametrize("package", [
-    "mdi_envs", "optimal", "benchmarks",
-    pytest.param("baselines", marks=pytest.mark.xfail(strict=True, reason="baselines.compare "
-                 "imports compare_plots and seed_plots, which import its OPTIMAL label back")),
-])
+@pytest.mark.parametrize("package", ["mdi_envs", "optimal", "benchmarks", "baselines"])
 def test_no_import_cycle(package: str) -> None:
     assert import_cycles(package) == []
 

@@ -12,6 +12,7 @@ from baselines.aggregate import (
     success_curve,
     training_curves,
 )
+from baselines.records import Estimate
 
 pytest.importorskip("rliable", reason="rliable is in the rl extra")
 
@@ -19,19 +20,20 @@ pytest.importorskip("rliable", reason="rliable is in the rl extra")
 def test_iqm_interval_trims_quartiles_and_brackets_the_estimate() -> None:
     values = [0.0, 0.9, 0.95, 1.0, 1.0, 1.0, 1.0, 10.0]  # IQM: mean of the middle four
     estimate = iqm_interval(values, reps=500)
-    assert estimate["iqm"] == pytest.approx(np.mean([0.95, 1.0, 1.0, 1.0]))
-    assert estimate["n"] == 8 and estimate["missing"] == 0
-    low, high = estimate["ci"]
-    assert low <= estimate["iqm"] <= high
+    assert estimate.iqm == pytest.approx(np.mean([0.95, 1.0, 1.0, 1.0]))
+    assert estimate.mean == pytest.approx(np.mean(values))
+    assert estimate.n == 8 and estimate.missing == 0
+    low, high = estimate.ci
+    assert low <= estimate.iqm <= high
+    assert iqm_interval(values, reps=0).ci is None  # no bootstrap: the estimates alone
     before = np.random.get_state()[1].copy()
     assert iqm_interval(values, reps=500) == estimate  # seeded resampling
     assert np.array_equal(np.random.get_state()[1], before)  # the global generator restored
 
 
 def test_iqm_interval_drops_missing_runs_and_gives_one_run_no_interval() -> None:
-    assert iqm_interval([1.5, None, float("nan")]) == {"n": 1, "missing": 2, "iqm": 1.5,
-                                                        "ci": None, "values": [1.5]}  # fmt: skip
-    assert iqm_interval([])["iqm"] is None
+    assert iqm_interval([1.5, None, float("nan")]) == Estimate(1, 2, 1.5, 1.5, None, [1.5])
+    assert iqm_interval([]).iqm is None and iqm_interval([]).mean is None
 
 
 def test_success_curve_is_the_moving_mean_of_finished_episodes() -> None:
@@ -52,9 +54,10 @@ def test_sampled_curve_spans_the_run() -> None:
 def test_training_curves_band_needs_two_runs() -> None:
     run = sampled_curve(np.arange(1.0, 201.0), (np.arange(200) > 100).astype(float))
     curves = training_curves({"one": [run], "two": [run, run]}, num_points=5, reps=100)
-    assert curves["one"]["ci"] is None and curves["one"]["n"] == 1
-    assert curves["two"]["ci"].shape == (2, 5)
-    assert curves["two"]["iqm"] == pytest.approx(curves["one"]["iqm"])
+    assert curves["one"].ci is None and curves["one"].n == 1
+    assert curves["two"].ci.shape == (2, 5)
+    assert curves["two"].iqm == pytest.approx(curves["one"].iqm)
+    assert curves["one"].steps == pytest.approx(np.geomspace(1.0, 200.0, 5))  # log step axis
 
 
 def test_performance_profile_counts_runs_above_tau() -> None:

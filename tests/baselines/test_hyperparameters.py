@@ -88,7 +88,7 @@ def test_shipped_policies_were_trained_with_the_table() -> None:
     import json
     from pathlib import Path
 
-    from baselines.compare import TRAINED_DIR
+    from baselines.evaluation import TRAINED_DIR
 
     configs = sorted(Path(TRAINED_DIR).glob("*.json"))
     assert configs, "no shipped policy"

@@ -11,7 +11,8 @@ import pytest
 
 from baselines.cli import add_train_parser
 from baselines.hyperparameters import get_hyperparameters
-from baselines.train import load_trained, plot_training, run_name
+from baselines.plots import plot_training
+from baselines.train import load_trained, run_name
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 TINY = {"policy_kwargs": {"net_arch": [16, 16]}}

@@ -1,0 +1,132 @@
+"""The Markdown tables of studies (pandas ``to_markdown``): the comparison and the robustness.
+
+``comparison_table``: one row per env x objective x condition x controller with the IQM [95 % CI]
+over runs (n) of each score, the nominal start, the compute per step and the training budget.
+``robustness_table``: per study, one row per controller and one column per condition with the
+success rate (mean over runs) and, over the successes, the time or effort ratio (mean over the
+runs with successes). Both read the rows' aggregates (``baselines.evaluation.aggregate``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from baselines.records import Estimate, Row, Study
+
+
+def interval_text(estimate: Estimate, percent: bool = False) -> str:
+    """"IQM [low, high] (n=k)", "value (n=1, no CI)" or "-" (no run with a score)."""
+    if estimate.iqm is None:
+        return "-"
+
+    def show(value: float) -> str:
+        return f"{100 * value:.0f} %" if percent else f"{value:.2f}"
+
+    missing = f", {estimate.missing} without" if estimate.missing else ""
+    if estimate.ci is None:
+        return f"{show(estimate.iqm)} (n={estimate.n}, no CI{missing})"
+    low, high = estimate.ci
+    return f"{show(estimate.iqm)} [{show(low)}, {show(high)}] (n={estimate.n}{missing})"
+
+
+def budget_text(row: Row, condition: str) -> str:
+    """A row's training budget and seeds, e.g. "1e+07 steps, 64 envs, seeds 0-4" ("" untrained)."""
+    trainings = [run.training for run in row.at(condition) if run.training is not None]
+    if not trainings:
+        return ""
+    seeds = sorted(t.seed for t in trainings)
+    seed_text = (f"seed {seeds[0]}" if len(seeds) == 1 else
+                 f"seeds {seeds[0]}-{seeds[-1]}" if seeds == list(range(seeds[0], seeds[-1] + 1))
+                 else "seeds " + ",".join(map(str, seeds)))  # fmt: skip
+    budget = "/".join(sorted({f"{t.num_timesteps:.2g}" for t in trainings}))
+    return f"{budget} steps, {trainings[0].num_envs} envs, {seed_text}"
+
+
+def _nominal_text(row: Row, condition: str) -> str:
+    nominals = [run.nominal for run in row.at(condition) if run.nominal is not None]
+    if not nominals:
+        return "-"
+    if row.trained:
+        return f"{sum(e.is_success for e in nominals)} of {len(nominals)} runs succeed"
+    (nominal,) = nominals
+    return (f"success, {nominal.elapsed_time:.2f} s, effort {nominal.effort:.3g}"
+            if nominal.is_success else "fails")  # fmt: skip
+
+
+def _compute_text(row: Row, condition: str) -> str:
+    """The mean wall time of one policy call over the row's perturbed episodes."""
+    times = [run.scores.compute_per_step for run in row.at(condition)]
+    if any(t is None for t in times):
+        return "-"
+    seconds = float(np.mean(times))
+    return f"{1e3 * seconds:.3g} ms" if seconds < 1.0 else f"{seconds:.2f} s"
+
+
+def comparison_table(studies: Sequence[Study]) -> str:
+    """One row per env x objective x condition x controller: IQM [95 % CI] over runs of each score.
+
+    A trained algorithm's runs are its training seeds; an untrained controller is one run (its
+    cells show the value alone). Needs each row's aggregates (``evaluation.aggregate``).
+    """
+    records = []
+    for study in studies:
+        for condition in study.conditions:
+            for row in study.rows:
+                estimates = row.aggregate(condition.label)
+                if estimates is None:
+                    continue
+                scores = (estimates.success_rate, estimates.time_ratio, estimates.effort_ratio)
+                runs = len(row.at(condition.label))
+                if row.trained:
+                    count = f"{runs} seed{'s' * (runs != 1)} x {study.num_starts} starts"
+                    cells = [interval_text(scores[0], percent=True),
+                             *(interval_text(e) for e in scores[1:])]
+                else:
+                    count = f"controller, {study.num_starts} starts"
+                    cells = [f"{100 * (scores[0].iqm or 0.0):.0f} %",
+                             *(f"{e.iqm:.2f}" if e.iqm is not None else "-" for e in scores[1:])]
+                label = condition.label
+                records.append([study.env_id.split("/")[-1], study.objective,
+                                f"{condition.scale:g}", row.label, count, *cells,
+                                _nominal_text(row, label), _compute_text(row, label),
+                                budget_text(row, label)])  # fmt: skip
+    columns = ["env", "objective", "start scale", "controller", "runs",
+               "success (perturbed starts), IQM [95 % CI]", "time / optimal",
+               "effort / optimal", "nominal start", "compute / step", "training budget"]
+    return pd.DataFrame(records, columns=columns).to_markdown(index=False)
+
+
+def robustness_table(studies: Sequence[Study]) -> str:
+    """Per study a title line and a table: success (ratio over the successes) per condition.
+
+    Success is the mean over the row's runs, the ratio the mean over its runs with successes
+    (each row's aggregates: ``evaluation.aggregate``).
+    """
+    parts = []
+    for study in studies:
+        ratio = "effort" if study.objective == "effort" else "time"
+        records = []
+        for row in study.rows:
+            cells, runs = [], 0
+            for condition in study.conditions:
+                estimates = row.aggregate(condition.label)
+                if estimates is None:
+                    cells.append("-")
+                    continue
+                mean = getattr(estimates, f"{ratio}_ratio").mean
+                runs = max(runs, estimates.success_rate.n)
+                cells.append(f"{estimates.success_rate.mean or 0.0:.0%}"
+                             + ("" if mean is None else f" ({mean:.2f})"))
+            records.append([row.label, runs, *cells])
+        table = pd.DataFrame(records, columns=["controller", "runs",
+                                               *(c.label for c in study.conditions)])
+        parts.append(f"{study.env_id} {study.objective} ({study.num_starts} starts per run; "
+                     f"success, {ratio}/optimal over the successes)\n\n"
+                     + table.to_markdown(index=False))
+    return "\n\n".join(parts)
+
+
+__all__ = ["budget_text", "comparison_table", "interval_text", "robustness_table"]
