@@ -1,0 +1,32 @@
+"""The docs say what is: no development history in the documentation, docstrings or comments."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+HISTORY = re.compile(
+    r"\bsession[- ]\d+|\bissue[- ]?\d+|\bscratch (?:run|probe|measurement|launcher)s?\b"
+    r"|\bused to\b|\bnot kept\b|\bwork period|\bshipped before\b|\bbefore this (?:change|module)",
+    re.IGNORECASE)
+"""Phrases that narrate how the code came to be rather than what it is."""
+CHECKED = ["README.md", "docs", "mdi_envs", "optimal"]
+"""What is kept free of history (files and folders, recursively: .md and .py)."""
+
+
+def _files() -> list[Path]:
+    paths: list[Path] = []
+    for name in CHECKED:
+        path = ROOT / name
+        paths += [path] if path.is_file() else sorted(
+            p for suffix in ("*.md", "*.py") for p in path.rglob(suffix))
+    return paths
+
+
+def test_no_development_history() -> None:
+    hits = [f"{path.relative_to(ROOT)}:{number}: {line.strip()}"
+            for path in _files()
+            for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+            if HISTORY.search(line)]
+    assert not hits, "development history:\n" + "\n".join(hits)
