@@ -84,10 +84,11 @@ class Scores:
 
     Attributes:
         episodes: how many. success_rate: fraction at the goal. time_ratio, effort_ratio: mean
-        time [s] and effort over the successes divided by the optimum's (None: no success).
-        time_ratio_median: the median's ratio. mean_time [s], mean_effort [N^2 m^2 s]: over
-        the successes. solver_failures: summed. compute_per_step: mean over the episodes [s].
-        The last five are None in a run recorded without them.
+            time [s] and effort over the successes divided by the optimum's (None: no success).
+        time_ratio_median: the median's ratio (the last five are None in a run recorded
+            without them).
+        mean_time, mean_effort: over the successes [s], [N^2 m^2 s].
+        solver_failures: summed. compute_per_step: mean over the episodes [s].
     """
 
     episodes: int

@@ -26,7 +26,7 @@ import pandas as pd
 
 import mdi_envs  # noqa: F401  (registers the ids)
 from baselines.records import read_study
-from baselines.tables import robustness_table
+from baselines.tables import comparison_table, robustness_table
 from optimal import available_references, load_reference
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -249,7 +249,7 @@ def benchmark_page() -> None:
 def comparison_page() -> None:
     """``results/comparison.md``: RL vs MPC vs optimal from ``baselines/comparison``."""
     folder = ROOT / "baselines" / "comparison"
-    runs = headline.comparisons(folder)
+    studies = headline.comparisons(folder)
     lines = ["# RL vs MPC vs optimal", "",
              "Generated from `baselines/comparison/compare_*.json` (written by "
              "`mdi-envs compare all --output baselines/comparison`). Each controller plays 20 "
@@ -257,7 +257,10 @@ def comparison_page() -> None:
              "time (or effort) over the optimal reference's, over the successes; IQM and 95 % "
              "stratified-bootstrap CI over runs (rliable). The method: "
              "[the baselines guide](../guide/baselines.md).", "",
-             headline.headline_frame(runs).to_markdown(index=False), ""]
+             headline.headline_frame(studies).to_markdown(index=False), "",
+             "In full (`baselines.tables.comparison_table`): the nominal start, the compute per "
+             "policy call and the training budget of each row.", "",
+             comparison_table(studies), ""]
     for png in sorted(folder.glob("*.png")):
         lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
     lines += ["## Shipped policies", "",

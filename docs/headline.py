@@ -8,11 +8,13 @@ The numbers come from ``baselines/comparison/compare_*.json`` (``mdi-envs compar
 from __future__ import annotations
 
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
 
 from baselines.records import Estimate, Row, Study, read_study
+from baselines.tables import interval_text
 
 ROOT = Path(__file__).resolve().parent.parent
 COMPARISON_DIR = ROOT / "baselines" / "comparison"
@@ -20,66 +22,58 @@ PLOT = ROOT / "docs" / "assets" / "headline.png"
 
 
 def comparisons(folder: Path = COMPARISON_DIR) -> list[Study]:
-    """Every committed ``compare_*.json``, sorted by env and objective."""
+    """Every committed ``compare_*.json`` (``baselines.records.read_study``), sorted by name."""
     return [read_study(p) for p in sorted(folder.glob("compare_*.json"))]
 
 
 def _scores(study: Study, row: Row) -> tuple[Estimate, Estimate]:
-    """A row's success and time or effort ratio at the study's first (nominal) condition."""
+    """The row's success rate and its ratio to the optimum (time or effort, the objective's)."""
     aggregate = row.aggregate(study.conditions[0].label)
-    assert aggregate is not None, f"{study.name} {row.label}: no aggregate"
+    if aggregate is None:
+        raise ValueError(f"{study.name}: row {row.label!r} has no aggregate")
     return aggregate.success_rate, getattr(aggregate, f"{study.objective}_ratio")
 
 
-def _interval(estimate: Estimate, percent: bool) -> str:
-    """"IQM [low, high]", the value alone without a CI, or "-" without any score."""
-    if estimate.iqm is None:
-        return "-"
-    show = (lambda v: f"{100 * v:.0f} %") if percent else (lambda v: f"{v:.2f}")
-    some = f" ({estimate.n} of {estimate.n + estimate.missing} runs)" if estimate.missing else ""
-    if estimate.ci is None:
-        return show(estimate.iqm) + some
-    low, high = estimate.ci
-    return f"{show(estimate.iqm)} [{show(low)}, {show(high)}]{some}"
+def _text(row: Row, estimate: Estimate, percent: bool = False) -> str:
+    """IQM [CI] over a trained row's runs; an untrained controller's one value alone."""
+    if row.trained or estimate.iqm is None:
+        return interval_text(estimate, percent)
+    return f"{100 * estimate.iqm:.0f} %" if percent else f"{estimate.iqm:.2f}"
 
 
-def headline_frame(runs: list[Study]) -> pd.DataFrame:
+def headline_frame(studies: list[Study]) -> pd.DataFrame:
     """One row per env x objective x controller: success and ratio to the optimum, IQM [CI]."""
     rows = []
-    for study in runs:
+    for study in studies:
         for row in study.rows:
             success, ratio = _scores(study, row)
-            rows.append({
-                "env": study.env_id.removeprefix("mdi_envs/"),
-                "objective": study.objective,
-                "controller": row.label,
-                "runs": success.n,
-                "success": _interval(success, percent=True),
-                "time or effort / optimal": _interval(ratio, percent=False),
-            })
+            rows.append({"env": study.env_id.removeprefix("mdi_envs/"),
+                         "objective": study.objective, "controller": row.label,
+                         "runs": success.n + success.missing,
+                         "success": _text(row, success, percent=True),
+                         "time or effort / optimal": _text(row, ratio)})
     return pd.DataFrame(rows)
 
 
-def headline_plot(runs: list[Study], path: Path = PLOT) -> Path:
-    """Success (bars) and ratio to the optimum (dots) per controller, one panel per objective."""
+def headline_plot(studies: list[Study], path: Path = PLOT) -> Path:
+    """Success (bars) and ratio to the optimum (dots) per controller, one panel per study."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(runs), figsize=(4.2 * len(runs), 3.4), squeeze=False)
-    for ax, run in zip(axes[0], runs, strict=True):
+    fig, axes = plt.subplots(1, len(studies), figsize=(4.2 * len(studies), 3.4), squeeze=False)
+    for ax, study in zip(axes[0], studies, strict=True):
         labels = [row.label.replace(" (shrinking horizon)", "").replace(" (open loop)",
                                                                         "\n(open loop)")
-                  for row in run.rows]
-        success, ratio = (list(scores) for scores in
-                          zip(*(_scores(run, row) for row in run.rows), strict=True))
+                  for row in study.rows]
+        success, ratio = zip(*(_scores(study, row) for row in study.rows), strict=True)
         x = range(len(labels))
-        ax.bar(x, [s.iqm for s in success], color="tab:green", alpha=0.8,
+        ax.bar(x, [s.iqm or 0.0 for s in success], color="tab:green", alpha=0.8,
                yerr=_errors(success), capsize=3, label="success (IQM, 95 % CI)")
         ax.set_ylim(0, 1.05)
         ax.set_xticks(list(x), labels, fontsize=7)
-        ax.set_title(f"{run.env_id.removeprefix('mdi_envs/')}, {run.objective}", fontsize=9)
+        ax.set_title(f"{study.env_id.removeprefix('mdi_envs/')}, {study.objective}", fontsize=9)
         twin = ax.twinx()
         shown = [i for i, r in enumerate(ratio) if r.iqm is not None]
         twin.errorbar(shown, [ratio[i].iqm for i in shown],
@@ -100,7 +94,7 @@ def headline_plot(runs: list[Study], path: Path = PLOT) -> Path:
     return path
 
 
-def _errors(estimates: list[Estimate]) -> list[list[float]]:
+def _errors(estimates: Sequence[Estimate]) -> list[list[float]]:
     """Asymmetric error bars (2, k) from IQM and CI (zero without a CI)."""
     low, high = [], []
     for e in estimates:
@@ -113,9 +107,9 @@ def _errors(estimates: list[Estimate]) -> list[list[float]]:
 
 def main() -> int:
     """Print the README table and write the plot."""
-    runs = comparisons()
-    print(headline_frame(runs).to_markdown(index=False))
-    print(f"wrote {headline_plot(runs).relative_to(ROOT)}", file=sys.stderr)
+    studies = comparisons()
+    print(headline_frame(studies).to_markdown(index=False))
+    print(f"wrote {headline_plot(studies).relative_to(ROOT)}", file=sys.stderr)
     return 0
 
 
