@@ -310,15 +310,16 @@ def controller_rows(env_id: str, objective: str, trained_dir: Path = TRAINED_DIR
     A trained algorithm has one run per seed. Only the labels in ``only`` (None: all; an
     unknown label: ValueError).
     """
-    rows = [(c.label, [c]) for c in registered_controllers(env_id, objective)]
-    for algo, paths in group_by_algorithm(shipped_policies(env_id, objective, trained_dir)).items():
-        rows.append((algo, [load_policy(path) for path in paths]))
-    rows += [(c.label, [c]) for c in extra]
+    trained = group_by_algorithm(shipped_policies(env_id, objective, trained_dir))
+    registered = [(c.label, [c]) for c in registered_controllers(env_id, objective)]
+    rows: list[tuple[str, Any]] = [*registered, *trained.items(),
+                                   *((c.label, [c]) for c in extra)]
     unknown = sorted(set(only or ()) - {label for label, _ in rows})
     if unknown:
         raise ValueError(f"no controller {', '.join(map(repr, unknown))} for {env_id} objective "
                          f"{objective!r}; known: {', '.join(label for label, _ in rows)}")
-    return [(label, runs) for label, runs in rows if only is None or label in only]
+    return [(label, [load_policy(run) if label in trained else run for run in runs])
+            for label, runs in rows if only is None or label in only]  # policies loaded last
 
 
 def evaluate(

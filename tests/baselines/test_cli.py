@@ -40,40 +40,52 @@ def two_seeds(tmp_path: Path) -> Path:
     return trained
 
 
-def test_compare_plays_trained_seeds_at_two_scales(two_seeds: Path, tmp_path: Path,
-                                                   capsys: pytest.CaptureFixture[str]) -> None:
+def test_compare_plays_two_scales_and_merges_a_rerun(tmp_path: Path,
+                                                     capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out"
-    common = ["compare", ROBOT, "--objective", "effort", "--seeds", "1", "--bootstrap-reps", "50",
-              "--trained", str(two_seeds), "--output", str(out)]  # fmt: skip
+    common = ["compare", ROBOT, "--objective", "effort", "--seeds", "1", "--trained",
+              str(tmp_path), "--output", str(out)]  # fmt: skip
     assert run(*common, "--scales", "0.01", "0.1") == 0
     table = capsys.readouterr().out
     assert (out / "compare.md").read_text().strip() == table.strip()
-    assert "| PPO " in table and "2 seeds x 1 starts" in table and "(n=2" in table
-    assert "5e+06 steps, 64 envs, seeds 0-1" in table
+    assert table.count(f"| {OPTIMAL} ") == 2  # one row per scale
     for name in ("compare_{}.png", "compare_{}_scale0.1.png", "seeds_{}.png", "compare_{}.md"):
         assert (out / name.format("DiffDriveRobot-v0_effort")).stat().st_size > 0, name
-    study = read_study(out / "compare_DiffDriveRobot-v0_effort.json")
-    assert [c.scale for c in study.conditions] == [0.01, 0.1]
-    ppo = study.row("PPO")
-    assert [run.seed for run in ppo.runs] == [0, 1, 0, 1] and all(run.commit for run in ppo.runs)
-    assert all(run.training.commit for run in ppo.runs)  # trained from a recorded commit
-    success = ppo.aggregate("perturbation 0.01").success_rate
-    assert success.n == 2 and success.mean == np.mean([r.scores.success_rate
-                                                         for r in ppo.at("perturbation 0.01")])
-    # a row rerun merges: the others stay; a trained row whose policies are gone is dropped
     path = out / "compare_DiffDriveRobot-v0_effort.json"
-    withdrawn = dataclasses.replace(ppo, label="SAC")
-    write_study(dataclasses.replace(study, rows=[*study.rows, withdrawn]), path)
+    study = read_study(path)
+    assert [c.scale for c in study.conditions] == [0.01, 0.1]
+    (optimal,) = study.rows
+    assert [run.condition.scale for run in optimal.runs] == [0.01, 0.1]
+    assert all(run.commit and run.nominal.trajectory for run in optimal.runs)
+    # a row rerun merges: the others stay; a trained row whose policies are gone is dropped
+    kept = dataclasses.replace(optimal, label="kept row")
+    withdrawn = dataclasses.replace(optimal, label="SAC", trained=True)
+    write_study(dataclasses.replace(study, rows=[kept, optimal, withdrawn]), path)
     assert run(*common, "--scales", "0.3", "--controllers", OPTIMAL) == 0
     merged = read_study(path)
     assert [c.scale for c in merged.conditions] == [0.01, 0.1, 0.3]
-    assert [row.label for row in merged.rows] == [OPTIMAL, "PPO"]
-    assert merged.row("PPO") == ppo
-    assert len(merged.row(OPTIMAL).runs) == 3
+    assert [row.label for row in merged.rows] == ["kept row", OPTIMAL]
+    assert merged.rows[0] == kept and len(merged.row(OPTIMAL).runs) == 3
+    assert "| kept row " in (out / "compare.md").read_text()
     with pytest.raises(SystemExit, match="no controller 'PP0'"):
         run(*common, "--controllers", "PP0")
     with pytest.raises(SystemExit, match="has no objective"):
         run("compare", MANIPULATOR, "--objective", "effort", "--output", str(out))
+
+
+def test_compare_aggregates_shipped_seeds(two_seeds: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert run("compare", ROBOT, "--objective", "effort", "--seeds", "1", "--bootstrap-reps",
+               "50", "--trained", str(two_seeds), "--output", str(out)) == 0
+    table = (out / "compare.md").read_text()
+    assert "2 seeds x 1 starts" in table and "(n=2" in table
+    assert "5e+06 steps, 64 envs, seeds 0-1" in table
+    ppo = read_study(out / "compare_DiffDriveRobot-v0_effort.json").row("PPO")
+    assert [run.seed for run in ppo.runs] == [0, 1]
+    assert all(run.commit and run.training.commit for run in ppo.runs)  # evaluated, trained at
+    success = ppo.aggregate("perturbation 0.01").success_rate
+    assert success.n == 2 and success.mean == np.mean([r.scores.success_rate for r in ppo.runs])
+    assert (out / "seeds_DiffDriveRobot-v0_effort.png").stat().st_size > 10_000
 
 
 def test_robustness_writes_json_plot_and_table(tmp_path: Path) -> None:
