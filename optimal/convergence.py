@@ -95,8 +95,9 @@ def solve_level(name: str, schedule: SwitchingSchedule, num_intervals: int,
     ``optimal.refinement.refine`` does, a coarse grid moves to the branch of an earlier lock.)
 
     Returns:
-        A plain-JSON record: N, cost, t_f, converged, the phases [s], the moves of the mode
-        search, wall time [s].
+        A plain-JSON record: N, cost, t_f, converged, the fixed pattern's cost, the phases [s],
+        the moves of the mode search and its round limit (0: the pattern as projected, an
+        upper bound of the branch's optimum), wall time [s].
     """
     from optimal.mode_search import improve_modes, solve_with_modes
     from optimal.transcription import Transcription
@@ -118,7 +119,7 @@ def solve_level(name: str, schedule: SwitchingSchedule, num_intervals: int,
     phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
     return {"num_intervals": num_intervals, "cost": best.cost, "final_time": best.final_time,
             "converged": best.success, "start_cost": fixed.cost, "phases": phases,
-            "moves": moves, "wall_time": time.perf_counter() - clock}
+            "moves": moves, "max_rounds": max_rounds, "wall_time": time.perf_counter() - clock}
 
 
 def _held_inputs(schedule: SwitchingSchedule, problem: Any, grid: np.ndarray) -> np.ndarray:
@@ -134,7 +135,10 @@ def _held_inputs(schedule: SwitchingSchedule, problem: Any, grid: np.ndarray) ->
 
 
 def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
-    """Rows N, cost, distance d_N = cost - continuous optimum, d_N / optimum, observed order.
+    """The refinement table: one row per level, coarsest first.
+
+    Rows: N, the projected pattern's cost, the cost after the mode search and its round limit,
+    the distance d_N = cost - continuous optimum, d_N / optimum, the observed order.
 
     The order of a row is log(d_N / d_N') / log(N' / N) with N' the next level (NaN for the
     last row or where a distance is not positive).
@@ -150,7 +154,8 @@ def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
             if distance > 0 and following > 0:
                 order = math.log(distance / following) / math.log(
                     levels[i + 1]["num_intervals"] / level["num_intervals"])
-        rows.append({"num_intervals": level["num_intervals"], "cost": level["cost"],
+        rows.append({"num_intervals": level["num_intervals"], "start_cost": level["start_cost"],
+                     "max_rounds": level.get("max_rounds", 8), "cost": level["cost"],
                      "distance": distance, "relative_distance": distance / optimum,
                      "order": order})
     return rows
@@ -227,11 +232,11 @@ def main(argv: list[str] | None = None) -> None:
         run_study(args.name, levels, max_rounds=args.rounds)
     path = CONTINUOUS_DIR / f"{args.name}_refinement.json"
     if path.exists():  # the table, as markdown
-        print("| N | t_f [s] | distance [s] | distance / optimum | observed order |\n"
-              "|---|---|---|---|---|")
+        print("| N | t_f, pattern projected [s] | t_f after the mode search [s] (rounds) | "
+              "distance [s] | distance / optimum | observed order |\n|---|---|---|---|---|---|")
         for row in study_table(json.loads(path.read_text())):
-            print("| {num_intervals} | {cost:.6f} | {distance:.3e} | {relative_distance:.3%} | "
-                  "{order:.2f} |".format(**row))
+            print("| {num_intervals} | {start_cost:.6f} | {cost:.6f} ({max_rounds}) | "
+                  "{distance:.3e} | {relative_distance:.3%} | {order:.2f} |".format(**row))
 
 if __name__ == "__main__":
     main()

@@ -21,7 +21,8 @@ def test_end_variants_replace_the_last_brake_phases() -> None:
 
 
 def test_study_table_gives_the_observed_order() -> None:
-    levels = {str(n): {"num_intervals": n, "cost": 2.0 + 0.3 / n ** 2} for n in (10, 20, 40)}
+    levels = {str(n): {"num_intervals": n, "cost": 2.0 + 0.3 / n ** 2, "start_cost": 2.1}
+              for n in (10, 20, 40)}
     rows = study_table({"continuous_cost": 2.0, "levels": levels})
     assert [row["num_intervals"] for row in rows] == [10, 20, 40]
     assert rows[0]["order"] == pytest.approx(2.0) and rows[1]["order"] == pytest.approx(2.0)
