@@ -323,6 +323,20 @@ def references_page() -> None:
              "The replay plays the reference's controls open loop through the simulator at the "
              "reference's step h and at h/10 (state error at t_f; the references are optima of "
              "the h-discrete system).", ""]
+    continuous = [load(p) for p in sorted((ROOT / "optimal" / "continuous").glob("*.json"))
+                  if not p.stem.endswith("_refinement")]
+    if continuous:
+        lines += ["## Continuous-time optima", "",
+                  "The mode sequence of a reference with its switching times and t_f optimized "
+                  "against the event-driven integrator (`optimal/continuous/NAME.json`; "
+                  "[method](../guide/optimal.md)).", "",
+                  table([{"reference": c["name"], "continuous-time t_f [s]": c.get("final_time"),
+                          "h-discrete optimum": c.get("discrete_cost"),
+                          "intervals N": c.get("discrete_num_intervals"),
+                          "relative difference": c.get("relative_difference"),
+                          "goal error": c.get("goal_error"),
+                          "integrator": (c.get("integrator") or {}).get("method")}
+                         for c in continuous], floatfmt=".7g"), ""]
     for path in sorted((ROOT / "optimal" / "search").glob("*_search.json")):
         run = load(path)
         name = path.stem.removesuffix("_search")
