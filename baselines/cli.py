@@ -15,7 +15,6 @@ manipulator's native hybrid action space (algorithm names are case-insensitive).
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -63,23 +62,23 @@ def add_train_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 def run_train(args: argparse.Namespace) -> int:
     """Handler of ``train``: trains, prints the saved paths and scores; returns 0."""
-    from baselines.train import train
+    from baselines.train import read_training, train
 
     progress = False if args.no_progress_bar else None
     model_path = train(args.env_id, args.algo, objective=args.objective, seed=args.seed,
                        total_timesteps=args.timesteps, output=args.output,
                        num_envs=args.num_envs, eval_episodes=args.eval_episodes,
                        progress_bar=progress)  # fmt: skip
-    config = json.loads(model_path.with_suffix(".json").read_text())
-    evaluation = config["evaluation"]
-    print(f"trained {config['algo']} on {config['env_id']} ({config['objective']}): "
-          f"{config['num_timesteps']} steps in {config['wall_time_s']:.1f} s, "
-          f"{config['num_episodes']} episodes")  # fmt: skip
-    if evaluation.get("mean_return") is not None:
-        print(f"evaluation ({evaluation['episodes']} episodes, deterministic): return "
-              f"{evaluation['mean_return']:.3f} +- {evaluation['std_return']:.3f}, success "
-              f"{evaluation['success_rate']:.0%}, elapsed {evaluation['mean_elapsed_time']:.3f} "
-              f"s, effort {evaluation['mean_effort']:.4g}")  # fmt: skip
+    record = read_training(model_path.with_suffix(".json"))
+    score = record.evaluation
+    print(f"trained {record.algo} on {record.env_id} ({record.objective}): "
+          f"{record.num_timesteps} steps in {record.wall_time_s:.1f} s, "
+          f"{record.num_episodes} episodes")  # fmt: skip
+    if score.mean_return is not None:
+        print(f"evaluation ({score.episodes} episodes, deterministic): return "
+              f"{score.mean_return:.3f} +- {score.std_return:.3f}, success "
+              f"{score.success_rate:.0%}, elapsed {score.mean_elapsed_time:.3f} "
+              f"s, effort {score.mean_effort:.4g}")  # fmt: skip
     for suffix in (".zip", ".json", ".png"):
         print(f"saved {model_path.with_suffix(suffix)}")
     print(f"TensorBoard: tensorboard --logdir {args.output / 'tensorboard'}")

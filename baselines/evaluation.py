@@ -196,18 +196,17 @@ def shipped_algorithms(env_id: str, objective: str, directory: Path = TRAINED_DI
 
 def load_policy(config_path: Path) -> Controller:
     """A trained policy (deterministic ``predict``) as a ``Controller`` labelled by its algo."""
-    from baselines.train import load_trained
+    from baselines.train import load_trained, read_training
 
-    config = json.loads(Path(config_path).read_text())
-    model = load_trained(config["algo"], Path(config_path).with_suffix(".zip"))
+    record = read_training(config_path)
+    model = load_trained(record.algo, Path(config_path).with_suffix(".zip"))
 
     def act(obs: Any) -> Any:
         return model.predict(obs, deterministic=True)[0]
 
-    training = Training(Path(config_path).stem, int(config["seed"]), config.get("commit"),
-                        int(config.get("num_timesteps", config.get("total_timesteps", 0))),
-                        int(config.get("num_envs", 1)))  # fmt: skip
-    return Controller(config["algo"], lambda _env: act, dict(config["env_kwargs"]), training)
+    training = Training(Path(config_path).stem, record.seed, record.commit,
+                        record.num_timesteps, record.num_envs)  # fmt: skip
+    return Controller(record.algo, lambda _env: act, dict(record.env_kwargs), training)
 
 
 def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: int,

@@ -25,7 +25,6 @@ Example (the plan's PPO/HybridPPO seeds, 16 runs of 10-80 min each on 2 cores)::
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -76,19 +75,18 @@ def run_trial(config: dict[str, Any]) -> dict[str, Any]:
     ``config["trial"]`` holds the ``Trial`` fields, ``config["train"]`` the keyword arguments of
     ``train`` shared by the grid (output, budget overrides, evaluation episodes).
     """
-    from baselines.train import train
+    from baselines.train import read_training, train
 
     trial, options = config["trial"], dict(config["train"])
     output = Path(options.pop("output"))
     path = train(trial["env_id"], trial["algo"], objective=trial["objective"], seed=trial["seed"],
                  output=output, progress_bar=False, **options)  # fmt: skip
-    record = json.loads(path.with_suffix(".json").read_text())
-    evaluation = record["evaluation"]
-    return {"stem": path.stem, "num_timesteps": record["num_timesteps"],
-            "wall_time_s": record["wall_time_s"],
-            "train_success_rate": record["train_last100"]["success_rate"],
-            "eval_success_rate": evaluation.get("success_rate"),
-            "eval_mean_return": evaluation.get("mean_return")}  # fmt: skip
+    record = read_training(path.with_suffix(".json"))
+    return {"stem": path.stem, "num_timesteps": record.num_timesteps,
+            "wall_time_s": record.wall_time_s,
+            "train_success_rate": record.train_last100.success_rate,
+            "eval_success_rate": record.evaluation.success_rate,
+            "eval_mean_return": record.evaluation.mean_return}  # fmt: skip
 
 
 def sweep(

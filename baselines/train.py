@@ -36,6 +36,7 @@ import platform
 import sys
 import time
 import warnings
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -71,6 +72,79 @@ class EpisodeLog(BaseCallback):
                                   float(info.get("elapsed_time", np.nan)),
                                   float(info.get("effort", np.nan))))  # fmt: skip
         return True
+
+
+@dataclass(frozen=True)
+class PolicyEvaluation:
+    """Deterministic episodes of a trained policy on ``gym.make`` (SB3's ``evaluate_policy``).
+
+    Attributes:
+        episodes: how many (0: none played, the scores None). seed: the first reset seed.
+        mean_return, std_return: over the episodes. mean_length [steps]. success_rate.
+        mean_elapsed_time [s]. mean_effort [N^2 m^2 s].
+    """
+
+    episodes: int
+    seed: int
+    mean_return: float | None = None
+    std_return: float | None = None
+    mean_length: float | None = None
+    success_rate: float | None = None
+    mean_elapsed_time: float | None = None
+    mean_effort: float | None = None
+
+
+@dataclass(frozen=True)
+class RecentEpisodes:
+    """Mean return and success rate of the last 100 training episodes (None: no episode)."""
+
+    mean_return: float | None
+    success_rate: float | None
+
+
+@dataclass(frozen=True)
+class TrainingRecord:
+    """A trained run's ``STEM.json``: its exact settings, provenance and scores.
+
+    Attributes:
+        env_id, objective, algo, seed: the run. num_envs: batched copies. total_timesteps:
+        the budget; num_timesteps: the steps SB3 took. normalize_reward: rewards scaled by
+        ``VecNormalize`` in training. algo_kwargs: the SB3 arguments (algo_overrides: those
+        replacing the table's). env_kwargs: the ``gym.make`` arguments. policy, device,
+        torch_threads: as trained. wall_time_s [s]. num_episodes: training episodes.
+        train_last100: the last 100 of them. evaluation: after training. versions: of the
+        packages. commit: the git commit trained at. date. command: the CLI equivalent.
+    """
+
+    env_id: str
+    objective: str
+    algo: str
+    seed: int
+    num_envs: int
+    total_timesteps: int
+    num_timesteps: int
+    algo_kwargs: dict[str, Any]
+    algo_overrides: dict[str, Any]
+    env_kwargs: dict[str, Any]
+    policy: str
+    device: str
+    torch_threads: int
+    wall_time_s: float
+    num_episodes: int
+    train_last100: RecentEpisodes
+    evaluation: PolicyEvaluation
+    versions: dict[str, str]
+    commit: str | None
+    date: str
+    command: str
+    normalize_reward: bool = False
+
+
+def read_training(path: Path) -> TrainingRecord:
+    """The ``TrainingRecord`` of a ``STEM.json`` (pydantic's ``ValidationError`` if malformed)."""
+    from baselines.records import from_json
+
+    return from_json(TrainingRecord, json.loads(Path(path).read_text()))
 
 
 def run_name(env_id: str, objective: str, algo: str, seed: int) -> str:
@@ -201,27 +275,22 @@ def train(
     evaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed=seed + 10_000)
     write_logs(log.rows, output / f"{stem}_episodes.csv", output / f"{stem}_curve.csv")
     recent = log.rows[-100:]
-    config = {
-        "env_id": env_id, "objective": objective, "algo": algo, "seed": seed,
-        "num_envs": num_envs, "total_timesteps": total_timesteps,
-        "normalize_reward": entry["normalize_reward"],
-        "num_timesteps": int(model.num_timesteps),
-        "algo_kwargs": algo_kwargs, "algo_overrides": algo_overrides or {},
-        "env_kwargs": env_kwargs, "policy": "MlpPolicy",
-        "device": "cpu", "torch_threads": torch.get_num_threads(),
-        "wall_time_s": wall_time, "num_episodes": len(log.rows),
-        "train_last100": {
-            "mean_return": float(np.mean([r[1] for r in recent])) if recent else None,
-            "success_rate": float(np.mean([r[3] for r in recent])) if recent else None,
-        },
-        "evaluation": evaluation,
-        "versions": versions(), "commit": git_commit(),
-        "date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-        "command": f"mdi-envs train {env_id} {algo} --objective {objective} --seed {seed} "
-                   f"--timesteps {total_timesteps} --num-envs {num_envs}"
-                   + (" (plus algo_overrides)" if algo_overrides else ""),
-    }
-    (output / f"{stem}.json").write_text(json.dumps(config, indent=2, default=str) + "\n")
+    record = TrainingRecord(
+        env_id=env_id, objective=objective, algo=algo, seed=seed, num_envs=num_envs,
+        total_timesteps=total_timesteps, num_timesteps=int(model.num_timesteps),
+        algo_kwargs=algo_kwargs, algo_overrides=algo_overrides or {}, env_kwargs=env_kwargs,
+        policy="MlpPolicy", device="cpu", torch_threads=torch.get_num_threads(),
+        wall_time_s=wall_time, num_episodes=len(log.rows),
+        train_last100=RecentEpisodes(
+            float(np.mean([r[1] for r in recent])) if recent else None,
+            float(np.mean([r[3] for r in recent])) if recent else None),
+        evaluation=evaluation, versions=versions(), commit=git_commit(),
+        date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        command=f"mdi-envs train {env_id} {algo} --objective {objective} --seed {seed} "
+                f"--timesteps {total_timesteps} --num-envs {num_envs}"
+                + (" (plus algo_overrides)" if algo_overrides else ""),
+        normalize_reward=entry["normalize_reward"])  # fmt: skip
+    (output / f"{stem}.json").write_text(json.dumps(asdict(record), indent=2, default=str) + "\n")
     from baselines.plots import plot_training
 
     plot_training(log.rows, output / f"{stem}.png", title=f"{stem} ({algo}, {num_envs} envs)")
@@ -229,20 +298,13 @@ def train(
 
 
 def evaluate(model: Any, env_id: str, env_kwargs: dict[str, Any], episodes: int,
-             seed: int) -> dict[str, Any]:  # fmt: skip
-    """SB3's ``evaluate_policy`` (deterministic) on ``gym.make``; returns scores.
-
-    Returns:
-        {"episodes", "seed", "mean_return", "std_return", "mean_length" [steps],
-        "success_rate", "mean_elapsed_time" [s], "mean_effort" [N^2 m^2 s]}; None values when
-        ``episodes`` is 0.
-    """
+             seed: int) -> PolicyEvaluation:  # fmt: skip
+    """SB3's ``evaluate_policy`` (deterministic) on ``gym.make`` from ``reset(seed=seed)``."""
     from stable_baselines3.common.evaluation import evaluate_policy
     from stable_baselines3.common.monitor import Monitor
 
-    result: dict[str, Any] = {"episodes": episodes, "seed": seed}
     if episodes <= 0:
-        return result
+        return PolicyEvaluation(episodes, seed)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = Monitor(gym.make(env_id, **env_kwargs))
@@ -256,14 +318,11 @@ def evaluate(model: Any, env_id: str, env_kwargs: dict[str, Any], episodes: int,
     returns, lengths = evaluate_policy(model, env, n_eval_episodes=episodes, deterministic=True,
                                        return_episode_rewards=True, callback=record)  # fmt: skip
     env.close()
-    result.update({
-        "mean_return": float(np.mean(returns)), "std_return": float(np.std(returns)),
-        "mean_length": float(np.mean(lengths)),
-        "success_rate": float(np.mean([bool(i.get("is_success")) for i in finals])),
-        "mean_elapsed_time": float(np.mean([i.get("elapsed_time", np.nan) for i in finals])),
-        "mean_effort": float(np.mean([i.get("effort", np.nan) for i in finals])),
-    })
-    return result
+    return PolicyEvaluation(
+        episodes, seed, float(np.mean(returns)), float(np.std(returns)), float(np.mean(lengths)),
+        float(np.mean([bool(i.get("is_success")) for i in finals])),
+        float(np.mean([i.get("elapsed_time", np.nan) for i in finals])),
+        float(np.mean([i.get("effort", np.nan) for i in finals])))
 
 
 def write_logs(rows: list[tuple[Any, ...]], episodes_path: Path, curve_path: Path) -> None:
@@ -295,6 +354,7 @@ def versions() -> dict[str, str]:
 
 
 __all__ = [
-    "EpisodeLog", "algorithm_class", "check_single_env", "evaluate", "load_trained",
-    "run_name", "train", "write_logs",
+    "EpisodeLog", "PolicyEvaluation", "RecentEpisodes", "TrainingRecord", "algorithm_class",
+    "check_single_env", "evaluate", "load_trained", "read_training", "run_name", "train",
+    "write_logs",
 ]

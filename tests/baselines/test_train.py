@@ -116,3 +116,19 @@ def test_plot_training_handles_empty_and_full_logs(tmp_path: Path) -> None:
     rows = [(100 * k, -float(k), 50, k % 2 == 0, 1.0, 2.0) for k in range(150)]
     plot_training(rows, tmp_path / "full.png", title="t")
     assert (tmp_path / "empty.png").stat().st_size > 0 and (tmp_path / "full.png").exists()
+
+
+def test_every_shipped_training_record_reads_back(tmp_path: Path) -> None:
+    from pydantic import ValidationError
+
+    from baselines.evaluation import TRAINED_DIR
+    from baselines.train import read_training
+
+    paths = sorted(TRAINED_DIR.glob("*.json"))
+    records = [read_training(path) for path in paths]
+    assert records and all(r.commit and r.evaluation.episodes > 0 for r in records)
+    broken = json.loads(paths[0].read_text())
+    del broken["evaluation"]["seed"]
+    (tmp_path / "broken.json").write_text(json.dumps(broken))
+    with pytest.raises(ValidationError, match="evaluation.seed"):
+        read_training(tmp_path / "broken.json")
