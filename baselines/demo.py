@@ -16,12 +16,12 @@ The solver timings and the manipulator under the paper's brake schedule are benc
 
 from __future__ import annotations
 
-import json
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import gymnasium as gym
+import numpy as np
 
 from mdi_envs import ENV_IDS
 from mdi_envs.rendering import save_animation
@@ -29,11 +29,14 @@ from mdi_envs.rollout import Rollout, open_loop_policy, rollout
 from optimal import available_references, load_reference
 from optimal.replay import env_actions, env_options
 
+if TYPE_CHECKING:
+    from baselines.train import TrainingRecord
+
 COMPARISON_TABLE = Path(__file__).parent / "comparison" / "compare.md"
 """The committed comparison table (``mdi-envs compare all --output baselines/comparison``)."""
 
 TRAINED_DIR = Path(__file__).parent / "trained"
-"""The shipped policies: one ``STEM.json`` (config and evaluation) beside each ``STEM.zip``."""
+"""The shipped policies: one ``STEM.json`` (``TrainingRecord``) beside each ``STEM.zip``."""
 
 
 def run_demo(output: Path) -> list[Path]:
@@ -67,42 +70,48 @@ def run_demo(output: Path) -> list[Path]:
         ref_time, ref_effort = (reference.last_info[key] for key in ("elapsed_time", "effort"))
         for result, config in played:
             info = result.last_info
-            print(f"{env_id} ({objective}) {config['algo']} seed {config['seed']}: "
+            print(f"{env_id} ({objective}) {config.algo} seed {config.seed}: "
                   f"{_outcome(result)}; time / optimal {info['elapsed_time'] / ref_time:.2f}, "
                   f"effort / optimal {info['effort'] / ref_effort:.2f}")
         if played:
             best = min(played, key=lambda pair: (not pair[0].last_info["is_success"],
                                                  pair[0].last_info["elapsed_time"]))[1]
-            stem = f"{env_id.split('/')[-1]}_{objective}_{best['algo']}_seed{best['seed']}"
-            frames = _play(best, record=True).frames[::2]
+            stem = f"{env_id.split('/')[-1]}_{objective}_{best.algo}_seed{best.seed}"
+            frames = _play(best, record_frames=True).frames[::2]
             written.append(save_animation(frames, output / f"{stem}.gif", fps=15))
     return written
 
 
-def _best_policies(env_id: str, objective: str) -> list[dict[str, Any]]:
-    """Per algorithm, the config (and ``path``) of the shipped policy evaluated best.
+def _best_policies(env_id: str, objective: str) -> list[TrainingRecord]:
+    """Per algorithm, the record of the shipped policy evaluated best.
 
     Best: the highest success rate, then the shortest mean elapsed time.
     """
-    best: dict[str, dict[str, Any]] = {}
+    from baselines.train import read_training
+
+    best: dict[str, TrainingRecord] = {}
+
+    def score(record: TrainingRecord) -> tuple[float, float]:
+        evaluation = record.evaluation
+        return -(evaluation.success_rate or 0.0), evaluation.mean_elapsed_time or np.inf
+
     for path in sorted(TRAINED_DIR.glob("*.json")):
-        config = json.loads(path.read_text())
-        if (config["env_id"], config["objective"]) != (env_id, objective):
-            continue
-        score = (-config["evaluation"]["success_rate"], config["evaluation"]["mean_elapsed_time"])
-        if config["algo"] not in best or score < best[config["algo"]]["score"]:
-            best[config["algo"]] = {**config, "score": score, "path": path.with_suffix(".zip")}
+        record = read_training(path)
+        if (record.env_id, record.objective) == (env_id, objective) and (
+                record.algo not in best or score(record) < score(best[record.algo])):
+            best[record.algo] = record
     return list(best.values())
 
 
-def _play(config: dict[str, Any], record: bool = False) -> Rollout:
+def _play(record: TrainingRecord, record_frames: bool = False) -> Rollout:
     """One deterministic episode of a shipped policy from the nominal start."""
-    from baselines.train import load_trained
+    from baselines.train import load_trained, run_name
 
-    model = load_trained(config["algo"], config["path"])
-    env_kwargs = {**config["env_kwargs"], "reset_noise_scale": 0.0}
-    return rollout(config["env_id"], lambda obs: model.predict(obs, deterministic=True)[0],
-                   record=record, **env_kwargs)  # fmt: skip
+    stem = run_name(record.env_id, record.objective, record.algo, record.seed)
+    model = load_trained(record.algo, TRAINED_DIR / f"{stem}.zip")
+    env_kwargs = {**record.env_kwargs, "reset_noise_scale": 0.0}
+    return rollout(record.env_id, lambda obs: model.predict(obs, deterministic=True)[0],
+                   record=record_frames, **env_kwargs)  # fmt: skip
 
 
 def _outcome(result: Rollout) -> str:
