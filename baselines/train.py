@@ -79,9 +79,13 @@ class PolicyEvaluation:
     """Deterministic episodes of a trained policy on ``gym.make`` (SB3's ``evaluate_policy``).
 
     Attributes:
-        episodes: how many (0: none played, the scores None). seed: the first reset seed.
-        mean_return, std_return: over the episodes. mean_length [steps]. success_rate.
-        mean_elapsed_time [s]. mean_effort [N^2 m^2 s].
+        episodes: how many (0: none played, the scores None).
+        seed: the first reset seed.
+        mean_return: over the episodes, with std_return its standard deviation.
+        mean_length: [steps].
+        success_rate: fraction of the episodes ended at the goal.
+        mean_elapsed_time: [s].
+        mean_effort: [N^2 m^2 s].
     """
 
     episodes: int
