@@ -28,7 +28,7 @@ demo: $(VENV)/.installed-rl,render
 test: $(VENV)/.installed-test
 	$(BIN)/mdi-envs compile all
 	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=10
-	$(BIN)/python -m mdi_envs bench --quick
+	$(BIN)/python -m mdi_envs bench --quick --skip stress
 
 # The docs site (MkDocs Material + mkdocstrings) into site/; strict: a broken link or reference
 # fails. Its generated pages read the committed JSON and parse the sources (nothing compiles).

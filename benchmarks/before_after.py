@@ -1,19 +1,8 @@
 """Speed before and after a change, in one run: the engine and env benchmarks on two trees.
 
-``python -m benchmarks.before_after --before DIR [--rounds 2] [--output benchmarks/results]``
-runs ``benchmarks.engine --quick --models manipulator,diff_drive`` and ``benchmarks.envs
---quick`` alternately (before, after, before, after, ...) in fresh interpreters, the ``before``
-ones on the package in DIR (a checkout of the earlier commit, e.g. ``git worktree add
-/tmp/before c88c156``), the ``after`` ones on this tree, both with this tree's benchmark code,
-and compares every speed target the two benchmarks record (µs per step,
-steps per second): the median over the rounds per tree and their ratio. Each run's speed probe
-(a compiled no-op call, ``benchmarks.timing.speed_probe``) is a row too: where it moved, the
-machine's phase did. Each round also runs ``benchmarks.in_place_probe`` on both mission models:
-the minimum over 300 batches is the code's speed, robust to those phases. Writes
-``before_after.json`` and ``before_after.png``, prints a Markdown table. Alternating the trees
-spreads this VM's slow phases over both (``benchmarks.timing`` measures why: pyperf's
-``compare_to`` and asv compare runs made one after the other). About 3 min per round (plus the
-before tree's compilation: it has no disk cache).
+``python -m benchmarks.before_after --before DIR [--rounds 2]`` runs the quick engine and env
+benchmarks and ``in_place_probe`` alternately on the package in DIR and on this tree, in fresh
+interpreters, and writes the medians and ratios to ``before_after.json`` and ``.png``.
 """
 
 from __future__ import annotations

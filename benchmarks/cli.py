@@ -1,21 +1,9 @@
-"""``mdi-envs bench [NAME ...] [--quick]``: the benchmark suite, one command.
+"""``mdi-envs bench [NAME ...] [--quick] [--skip NAME ...]``: the benchmark suite, one command.
 
-Each NAME runs one benchmark module's ``main`` with ``--output`` (and ``--quick``) and writes its
-JSON and PNG files there; ``headline`` then collects the headline numbers of whatever results the
-folder holds into ``headline.json`` and ``headline.md``. Without NAME every benchmark runs, in
-the order of ``BENCHMARKS``. The exit code is non-zero when a benchmark crashes or a stress case
-fails (``--quick`` runs inside ``make test`` and so checks the stress criteria on every commit).
-
-Registered in ``pyproject.toml`` as the ``mdi_envs.commands`` entry point ``bench`` (the
-plug-in interface is in ``mdi_envs/cli.py``); its handler is ``run_bench``.
-
-The benchmarks are not installed with the package (``pyproject.toml`` lists ``mdi_envs``,
-``optimal`` and ``baselines`` only): they measure this repository's code, write their results
-into its ``benchmarks/results`` and run their probes as ``python -m benchmarks.NAME`` from its
-root, so they need the source tree anyway, and an installed top-level package named
-``benchmarks`` would shadow any other of that generic name. Run them from the repository's
-root: ``python -m mdi_envs bench`` (``-m`` puts the current folder on the import path; the
-``mdi-envs`` script does not) or ``make bench``.
+Each NAME runs one module's ``main`` into ``--output``; ``headline`` then tabulates the targets of
+the results found there. Exit code 1 when a benchmark crashes or a stress case fails.
+Registered as the ``mdi_envs.commands`` entry point ``bench``; not installed with the package, it
+runs from the repository's root (``python -m mdi_envs bench``), whose results folder it writes.
 """
 
 from __future__ import annotations
@@ -62,6 +50,8 @@ def add_bench_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help=f"benchmarks to run (default: all of {', '.join(BENCHMARKS)})")
     parser.add_argument("--quick", action="store_true",
                         help="small grids and budgets (about 2-3 min for all; used by make test)")
+    parser.add_argument("--skip", nargs="+", default=[], metavar="NAME",
+                        help="benchmarks to leave out (make test: stress, which pytest runs)")
     parser.add_argument("--output", type=Path, default=None, help="results folder")
     parser.set_defaults(handler=run_bench)
     return parser
@@ -71,8 +61,8 @@ def run_bench(args: argparse.Namespace) -> int:
     """Handler of ``bench``: runs the chosen benchmarks, then the headline table; exit code."""
     from benchmarks.headline import write_headline
 
-    names = list(args.names) or list(BENCHMARKS)
-    unknown = [name for name in names if name not in BENCHMARKS]
+    names = [name for name in args.names or BENCHMARKS if name not in args.skip]
+    unknown = [name for name in [*names, *args.skip] if name not in BENCHMARKS]
     if unknown:
         raise SystemExit(f"bench: unknown benchmark {', '.join(unknown)}; "
                          f"choose from {', '.join(BENCHMARKS)}")  # fmt: skip

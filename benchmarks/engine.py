@@ -1,25 +1,9 @@
-"""Engine benchmark: µs per Moreau-Jean step, single and batched, the shortcuts, and MuJoCo.
+"""Engine benchmark: µs per Moreau-Jean step (single, in place, batched), shortcuts, MuJoCo.
 
-Usage (from the repository root)::
-
-    python -m benchmarks.engine --output results/bench
-    python -m benchmarks.engine --output /tmp/bench --quick   # manipulator only, ~20 s, for tests
-
-Writes ``engine.json``, ``engine_batched.png``, ``engine_single_step.png`` and
-``engine_shortcuts.png`` to the output folder, prints progress lines on stderr and the Markdown
-results tables (the ones in ``benchmarks/README.md``) on stdout. Parts:
-
-1. compile: the first ``step`` and ``step_batch`` call of every stepper (numba JIT), timed once
-   and excluded from everything else;
-2. single step: ``MoreauJeanStepper.step`` from Python per scene, ``InPlaceStepper.step`` (one
-   compiled call on a flat buffer: the fastest single step from Python), the in-kernel cost per step
-   (``step_batch`` on N copies of the one scene), and MuJoCo's ``mj_step`` / ``rollout``;
-3. batched: µs per copy-step of ``step_batch`` on each model's scene mix for N = 1 ... 4096,
-   each call lasting at least ``call_s``, interleaved with MuJoCo's single-thread ``rollout``;
-4. shortcuts: each exact shortcut of ``StepShortcuts`` on vs off on the same scene (batched),
-   and the cost of a step with a closed contact / engaged brake against a free one;
-5. brake stop: steps until the relative velocity is below 1 % after the brake engages at
-   1 rad/s, ours against MuJoCo's soft equality constraint.
+``python -m benchmarks.engine [--output DIR] [--quick] [--models a,b]`` writes ``engine.json``
+and ``engine_{batched,single_step,shortcuts}.png``: compile times, single steps from Python,
+in-kernel cost per scene, batched µs per copy-step against N, each exact shortcut on vs off,
+substeps per call and the brake stop, each against MuJoCo's arm where it applies.
 """
 
 from __future__ import annotations

@@ -1,17 +1,9 @@
-"""MuJoCo peer of the blockable manipulator: the same two-link arm in MJCF, timed like ours.
+"""MuJoCo peers: the blockable manipulator as a two-link MJCF arm, and the bouncing ball.
 
-Two uniform rods (1 m, 1 kg, inertia m l^2 / 12 about the centre, given explicitly so that the
-capsule geoms, which have no collisions, carry no mass), hinge joints about z, gravity off,
-contacts off, timestep ``TIME_STEP``, the default Euler integrator. Joint 1 is link 1's
-absolute angle alpha and carries the motor; joint 2, a child of link 1, is the relative angle
-beta - alpha. So MuJoCo's coordinates are ``(alpha, beta - alpha)`` and its mass matrix is
-``T^T M T`` of ours with ``T = [[1, 0], [1, 1]]`` (checked at run time, ``mass_matrix_check``).
-
-The brake is ``<equality><joint joint1="j2" polycoef="r0 0 0 0 0"/>``: with
-``eq_active`` on it holds joint 2 at ``r0`` (set to the relative angle at which it engages)
-through MuJoCo's soft constraint (default ``solref = (0.02, 1)``, ``solimp = (0.9, 0.95,
-0.001)``); released, it is off. The Tresca brake is ``frictionloss`` on joint 2 (dry friction of
-a fixed bound), which needs its own ``MjModel``.
+The arm's coordinates are ``(alpha, beta - alpha)`` (mass matrix ``T^T M T``, checked at run
+time); its brake is a joint equality switched by ``eq_active`` (soft, ``solref``), its Tresca
+brake ``frictionloss``. The ball is a sphere on a slide joint whose restitution comes from the
+contact's ``solref`` damping ratio, by the damped-oscillator formula or calibrated per dt.
 """
 
 from __future__ import annotations

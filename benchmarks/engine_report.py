@@ -8,14 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import (
-    format_us_fine,
-    markdown_table,
-    plt,
-    run_line,
-    save_figure,
-    targets_table,
-)
+from benchmarks.report import format_us_fine, plt, save_figure, summary
 
 MODEL_TITLES = {
     "ball": "bouncing ball",
@@ -24,14 +17,6 @@ MODEL_TITLES = {
     "diff_drive": "diff-drive robot",
     "mujoco": "MuJoCo arm (rollout, 1 thread)",
 }
-
-SHORTCUT_TITLES = {
-    "skip_frictionless_rows": "skip_frictionless_rows",
-    "reuse_constant_mass": "reuse_constant_mass",
-    "direct_solve_max_size": "direct_solve_max_size 3 vs 0",
-    "no_solve": "no closed contact / brake → no solve (no switch: free vs active step)",
-}
-
 
 def shortcuts_text(shortcuts: Any) -> str:
     """The fields of a ``StepShortcuts`` that differ from the defaults, as ``a=b`` text."""
@@ -54,134 +39,32 @@ def case_record(case: Any) -> dict[str, Any]:
     }
 
 
-def compile_table(records: Sequence[dict[str, Any]]) -> str:
-    """Markdown: stepper, first step() [s], first step_batch() [s]."""
-    return markdown_table([{
-        "stepper": r["stepper"],
-        "first step() s": "–" if r["step_s"] is None else f"{r['step_s']:.1f}",
-        "first step_batch() s (after step)": f"{r['step_batch_s']:.1f}"} for r in records])
-
-
-def scenes_table(models: Sequence[dict[str, Any]]) -> str:
-    """Markdown: model, scene, in the batched mix?, description."""
-    return markdown_table([{
-        "model": m["label"], "scene": s["name"], "in the batched mix": "yes" if s["name"] in
-        m["mix"] else "no", "what": s["description"]} for m in models for s in m["scenes"]])
-
-
-def single_step_table(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str, Any]]
-                      ) -> str:
-    """Markdown: per (model, scene) the Python step, the in-place step and the in-kernel cost."""
-    index = {(r["model"], r["scene"], r["entry"]): r["median_s"] for r in single}
-    kernel = {(r["model"], r["scene"]): r["per_copy_step_s"] for r in scenes}
-    copies = scenes[0]["copies"] if scenes else "N"
-    return markdown_table([{
-        "model": "MuJoCo arm" if model == "mujoco" else MODEL_TITLES.get(model, model),
-        "scene": scene,
-        "one step from Python µs (step() / MuJoCo mj_step)": format_us_fine(
-            index.get((model, scene, "mj_step" if model == "mujoco" else "step"))),
-        "InPlaceStepper.step() from Python µs": format_us_fine(
-            index.get((model, scene, "in_place"))),
-        f"in-kernel µs per step (batched, N = {copies})": format_us_fine(
-            kernel.get((model, scene)))}
-        for model, scene in dict.fromkeys((r["model"], r["scene"]) for r in single)])
-
-
-def batched_table(batched: Sequence[dict[str, Any]]) -> str:
-    """Markdown: rows N, columns models (and MuJoCo), cells µs per copy-step."""
-    models = list(dict.fromkeys(r["model"] for r in batched))
-    sizes = sorted({r["copies"] for r in batched})
-    index = {(r["model"], r["copies"]): r for r in batched}
-    def cell(r: dict[str, Any] | None) -> str:
-        return "–" if r is None else f"{format_us_fine(r['per_copy_step_s'])} (×{r['substeps']:,})"
-
-    return markdown_table([{"N": str(n), **{MODEL_TITLES.get(m, m): cell(index.get((m, n)))
-                                           for m in models}} for n in sizes])
-
-
-def substeps_table(substeps: Sequence[dict[str, Any]]) -> str:
-    """Markdown: rows models, columns substeps per call, cells µs per copy-step."""
-    models = list(dict.fromkeys(r["model"] for r in substeps))
-    grid = sorted({r["substeps"] for r in substeps})
-    index = {(r["model"], r["substeps"]): r["per_copy_step_s"] for r in substeps}
-    rows = [[MODEL_TITLES.get(m, m), *(format_us_fine(index.get((m, k))) for k in grid)]
-            for m in models]
-    return markdown_table(rows, ["model", *(f"{k} substeps/call" for k in grid)])
-
-
-def shortcuts_table(shortcuts: Sequence[dict[str, Any]]) -> str:
-    """Markdown: shortcut, model/scene, on µs, off µs, speedup, largest state difference."""
-    return markdown_table([{
-        "shortcut": SHORTCUT_TITLES.get(r["shortcut"], r["shortcut"]),
-        "model / scene": f"{r['model']} / {_scene(r)}",
-        "on µs": format_us_fine(r["on"]["per_copy_step_s"]),
-        "off µs": format_us_fine(r["off"]["per_copy_step_s"]),
-        "speedup off/on (medians)": f"{r['speedup']:.2f}",
-        "speedup (fastest rounds)": f"{r['speedup_fastest_rounds']:.2f}",
-        "largest state difference on vs off": "–" if r["max_state_difference"] is None
-        else f"{r['max_state_difference']:.1e}"} for r in shortcuts])
-
-
-def _scene(row: Mapping[str, Any]) -> str:
-    """A shortcut row's scene, or both scenes where on and off ran different ones."""
-    same = row["off_scene"] == row["scene"]
-    return row["scene"] if same else f"{row['scene']} vs {row['off_scene']}"
-
-
-def brake_stop_table(brake: Mapping[str, Any]) -> str:
-    """Markdown: simulator/setting, steps to stop, relative angle at the stop."""
-    titles = {
-        "ours": "ours (ideal brake, Moreau-Jean)",
-        "mujoco_default": "MuJoCo joint equality, default solref/solimp",
-        "mujoco_stiffest": "MuJoCo joint equality, solref timeconst = 2 dt (stiffest allowed)",
-    }
-    rows = []
-    for key, value in brake.items():
-        setting = ""
-        if "solref" in value:
-            setting = (f"solref ({value['solref'][0]:g}, {value['solref'][1]:g}), solimp "
-                       f"({', '.join(f'{x:g}' for x in value['solimp'][:3])})")
-        elif "relative_speed_after_first_step" in value:
-            speed = value["relative_speed_after_first_step"]
-            setting = f"relative velocity after step 1: {speed:.1e} rad/s"
-        rows.append({"simulator": titles.get(key, key), "setting": setting,
-                     "steps until relative velocity < 1 % of 1 rad/s": "not reached"
-                     if value["steps"] is None else str(value["steps"]),
-                     "relative angle then (rad)": f"{value['relative_angle_at_stop']:.2e}"})
-    return markdown_table(rows)
-
-
 def markdown_report(record: Mapping[str, Any]) -> str:
-    """All result tables of one run, as printed on stdout and pasted into the README."""
-    lines = [run_line(record, ("numpy", "numba", "mujoco"))]
-    if record["notes"]:
-        lines += ["", *(f"* {note}" for note in record["notes"])]
-    lines += ["", "**Targets**", "", targets_table(record["targets"])]
-    lines += ["", "**Scenes**", "", scenes_table(record["models"])]
-    lines += ["", "**Compile time** (first calls in this process; numba JIT, excluded from "
-              "every timing below)", "", compile_table(record["compile"])]
-    lines += ["", "**One step** (median µs per step; MuJoCo rows: the same arm in MJCF)", "",
-              single_step_table(record["single_step"], record["per_scene"])]
-    lines += ["", "**Batched: µs per copy-step of `step_batch(Q, U, TAU, BRAKE, substeps)`** "
-              "(each model's scene mix, copy i in scene i mod k; in parentheses the substeps per "
-              "call, sized so that one call lasts ≥ "
-              f"{record['config']['call_s'] * 1e3:g} ms)", "", batched_table(record["batched"])]
-    if record["substeps"]:
-        copies = record["substeps"][0]["copies"]
-        lines += ["", f"**Substeps per call** (µs per copy-step, each model's mix, N = {copies})",
-                  "", substeps_table(record["substeps"])]
-    if record["shortcuts"]:
-        copies = record["shortcuts"][0]["on"]["copies"]
-        lines += ["", f"**Shortcuts** (in-kernel µs per copy-step, batched N = {copies}, the "
-                  "same scene on every copy; off/on > 1: the shortcut saves time)", "",
-                  shortcuts_table(record["shortcuts"])]
-    if record["brake_stop"]:
-        lines += ["", "**Brake stop** (relative velocity 1 rad/s, link 1 at rest, no torque; "
-                  "then the brake engages)", "", brake_stop_table(record["brake_stop"])]
-    if "mujoco_mass_matrix_difference" in record:
-        lines += ["", "MuJoCo arm check: largest |M_MuJoCo − Tᵀ M_ours T| at the scene state = "
-                  f"{record['mujoco_mass_matrix_difference']:.1e}."]
-    return "\n".join(lines)
+    """The targets and the result tables of one run (printed on stdout)."""
+    per_copy = ["model", "scene", "copies", "substeps", "per_copy_step_s"]
+    return summary(record, ("numpy", "numba", "mujoco"), {
+        "Compile time [s] (first calls, excluded from every timing)": record["compile"],
+        "One step from Python [s] (median)": (record["single_step"],
+                                              ["model", "scene", "entry", "median_s", "q1_s",
+                                               "q3_s"]),
+        "In-kernel step per scene [s]": (record["per_scene"], per_copy),
+        "Batched: s per copy-step of step_batch, each model's scene mix": (record["batched"],
+                                                                          per_copy),
+        "Substeps per call [s per copy-step]": (record["substeps"], per_copy),
+        "Shortcuts on vs off [s per copy-step]": (record["shortcuts"], [
+            "shortcut", "model", "scene", "off_scene", "on.per_copy_step_s",
+            "off.per_copy_step_s", "speedup", "speedup_fastest_rounds",
+            "max_state_difference"]),
+        "Brake stop (steps until the relative velocity < 1 % of 1 rad/s)": brake_rows(
+            record.get("brake_stop")),
+    })
+
+
+def brake_rows(brake: Mapping[str, Any] | None) -> tuple[list[dict[str, Any]], list[str]]:
+    """The brake-stop study as table rows (simulator, steps, relative angle, solref)."""
+    rows = [{"simulator": key, **value} for key, value in (brake or {}).items()]
+    return rows, ["simulator", "steps", "relative_angle_at_stop", "solref",
+                  "relative_speed_after_first_step"]
 
 
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],
@@ -270,7 +153,8 @@ def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
         labels = []
         for r in shortcuts:
             name = "no solve (free vs active)" if r["shortcut"] == "no_solve" else r["shortcut"]
-            labels.append(f"{name}: {r['model']} / {_scene(r)}")
+            scene = r["scene"] + ("" if r["off_scene"] == r["scene"] else f" vs {r['off_scene']}")
+            labels.append(f"{name}: {r['model']} / {scene}")
         y = np.arange(len(shortcuts))
         speedups = [r["speedup"] for r in shortcuts]
         colors = ["tab:gray" if r["shortcut"] == "no_solve" else "tab:blue" for r in shortcuts]
@@ -293,13 +177,5 @@ def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
     save_figure(fig, path)
 
 
-__all__ = [
-    "MODEL_TITLES",
-    "brake_stop_table",
-    "case_record",
-    "markdown_report",
-    "plot_batched",
-    "plot_shortcuts",
-    "plot_single_step",
-    "shortcuts_text",
-]
+__all__ = ["MODEL_TITLES", "brake_rows", "case_record", "markdown_report", "plot_batched",
+           "plot_shortcuts", "plot_single_step", "shortcuts_text"]

@@ -1,9 +1,6 @@
 """Scenes of the engine benchmark: the models, their representative states and the steppers.
 
-A scene is one state and one input of one model (``q, u, tau, brake_bound``). The single-step
-timings call ``MoreauJeanStepper.step`` on it again and again (the state does not advance); the
-batched timings give copy i of N the scene ``i mod k`` of its model's k scenes and advance all
-copies from there (each timed call starts again from these states).
+Copy i of N gets scene ``i mod k`` of its model's k scenes; each timed call restarts from them.
 """
 
 from __future__ import annotations
@@ -222,19 +219,6 @@ def stepper(case: ModelCase, shortcuts: StepShortcuts | None = None) -> MoreauJe
                              shortcuts=StepShortcuts() if shortcuts is None else shortcuts)
 
 
-__all__ = [
-    "BLOCK_SCENES",
-    "DIFF_DRIVE_SCENES",
-    "MANIPULATOR_Q",
-    "MANIPULATOR_U",
-    "MOTOR_TORQUE",
-    "TIME_STEP",
-    "TRESCA_BOUND",
-    "BatchedCall",
-    "ModelCase",
-    "Scene",
-    "batch_arrays",
-    "calibrate_substeps",
-    "model_cases",
-    "stepper",
-]
+__all__ = ["BLOCK_SCENES", "DIFF_DRIVE_SCENES", "MANIPULATOR_Q", "MANIPULATOR_U", "MOTOR_TORQUE",
+           "TIME_STEP", "TRESCA_BOUND", "BatchedCall", "ModelCase", "Scene", "batch_arrays",
+           "calibrate_substeps", "model_cases", "stepper"]

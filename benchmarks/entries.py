@@ -1,9 +1,4 @@
-"""The solver entry points under test, each with a uniform way to read its outcome.
-
-Every entry is timed on its bare call (``entry.solve(M, q)``); reading the outcome (status,
-iterations, the residual recomputed with our shared ``lcp_residual``) happens afterwards, outside
-the timed region.
-"""
+"""The solver entry points under test, each timed on its bare call and read afterwards."""
 
 from __future__ import annotations
 
@@ -127,16 +122,6 @@ def size_study_entries(n: int) -> list[Entry]:
     return [driver_entry(m) for m in methods] + [QUANTECON]
 
 
-__all__ = [
-    "DRIVER_LEMKE",
-    "ENUMERATIVE_MAX_N",
-    "KERNEL",
-    "LCP_METHODS",
-    "QUANTECON",
-    "QUANTECON_MAX_ITER",
-    "QUANTECON_STATUS",
-    "Entry",
-    "Outcome",
-    "driver_entry",
-    "size_study_entries",
-]
+__all__ = ["DRIVER_LEMKE", "ENUMERATIVE_MAX_N", "KERNEL", "LCP_METHODS", "QUANTECON",
+           "QUANTECON_MAX_ITER", "QUANTECON_STATUS", "Entry", "Outcome", "driver_entry",
+           "size_study_entries"]

@@ -1,26 +1,9 @@
 """Environment benchmark: ``env.step`` µs through ``gym.make`` and vector-env throughput.
 
-Usage (from the repository root)::
-
-    python -m benchmarks.envs --output results/bench
-    python -m benchmarks.envs --output /tmp/bench --quick   # manipulator vs Acrobot, N <= 256
-
-Writes ``envs.json``, ``envs_step.png`` and ``envs_vector.png`` to the output folder, prints
-progress lines on stderr and the Markdown results tables (the ones in ``benchmarks/README.md``)
-on stdout. Parts:
-
-1. first call: ``gym.make`` + ``reset`` + the first ``step`` of every environment, timed once
-   (for ours it holds the numba JIT compile) and excluded from everything else;
-2. single env: ``env.step`` of every registered ``mdi_envs.ENV_IDS`` and of the peers
-   (Gymnasium's ``Acrobot-v1``, MuJoCo's ``InvertedDoublePendulum-v5``) through ``gym.make``
-   (default wrappers) and unwrapped, interleaved, with pre-sampled actions and a reset whenever
-   an episode ends, ``STEPS_PER_CALL`` steps per timed call in a plain ``for`` loop;
-3. vector env: env-steps/s of ``gym.make_vec(id, num_envs=N,
-   vectorization_mode="vector_entry_point")`` for each N, interleaved per N with Acrobot-v1 in
-   Gymnasium's ``"sync"`` mode (N <= 256), and physics steps/s = env-steps/s x frame_skip.
-
-The process is pinned to one CPU (``--cpu``, default 0) for the run; numba threading is not
-used (no kernel of ``mdi_envs`` is parallel).
+``python -m benchmarks.envs [--output DIR] [--quick] [--cpu N]`` writes ``envs.json``,
+``envs_step.png`` and ``envs_vector.png``: first calls, ``env.step`` of every id and of Acrobot-v1
+and InvertedDoublePendulum-v5 (wrapped and unwrapped, interleaved), and ``gym.make_vec`` steps/s
+against N beside Acrobot in ``"sync"`` mode. The process is pinned to one CPU (``--cpu -1``: not).
 """
 
 from __future__ import annotations

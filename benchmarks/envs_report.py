@@ -8,14 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import (
-    format_ratio,
-    markdown_table,
-    plt,
-    run_line,
-    save_figure,
-    targets_table,
-)
+from benchmarks.report import plt, save_figure, summary
 
 SHORT_NAMES = {
     "mdi_envs/BlockableManipulator-v0": "BlockableManipulator",
@@ -31,58 +24,16 @@ def short_name(env_id: str) -> str:
     return name[:-3] if env_id.startswith("mdi_envs/") and name.endswith("-v0") else name
 
 
-def single_table(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]]) -> str:
-    """Markdown: per env the step times, frame_skip, µs per physics step and the ratios."""
-    peers = [r["env_id"] for r in single if not r["ours"]]
-    header = ["env", "env.step µs, gym.make (median, quartiles)", "fastest round µs",
-              "unwrapped µs", "frame_skip", "µs per physics step (gym.make)",
-              "first make+reset+step s", *(f"{short_name(p)} / ours" for p in peers)]
-    rows = [[f"{short_name(r['env_id'])}{'' if r['ours'] else ' (peer)'}",
-             f"{r['gym.make']['median_us']:.1f} ({r['gym.make']['q1_us']:.1f}–"
-             f"{r['gym.make']['q3_us']:.1f})", f"{r['gym.make']['min_us']:.1f}",
-             f"{r['unwrapped']['median_us']:.1f}", str(r["frame_skip"]),
-             f"{r['per_physics_step_us']:.1f}",
-             f"{r['first_make_s'] + r['first_reset_s'] + r['first_step_s']:.2f}",
-             *("–" if not r["ours"] or peer not in r.get("ratios", {})
-               else format_ratio(r["ratios"][peer]["ratio_median"]) for peer in peers)]
-            for r in single]
-    rows += [[f"{short_name(item['env_id'])} (peer)", f"not measured: {item['error']}",
-              *("" for _ in header[2:])] for item in unavailable]
-    return markdown_table(rows, header)
-
-
-def vector_table(vector: Sequence[dict[str, Any]]) -> str:
-    """Markdown: rows N, columns env (mode): env-steps/s · physics steps/s."""
-    columns = list(dict.fromkeys((r["env_id"], r["mode"]) for r in vector))
-    sizes = sorted({r["num_envs"] for r in vector})
-    index = {(r["env_id"], r["mode"], r["num_envs"]): r for r in vector}
-    def cell(r: dict[str, Any] | None) -> str:
-        return "–" if r is None else f"{r['env_steps_per_s']:.3g} · {r['physics_steps_per_s']:.3g}"
-
-    return markdown_table([{"num_envs": str(n), **{
-        f"{short_name(e)} ({'sync' if m == 'sync' else 'vector'})": cell(index.get((e, m, n)))
-        for e, m in columns}} for n in sizes])
-
-
 def markdown_report(record: Mapping[str, Any]) -> str:
-    """All result tables of one run, as printed on stdout and pasted into the README."""
-    pinning = record["pinning"]
-    lines = [run_line(record, ("numpy", "numba", "gymnasium", "mujoco")) + " Python "
-             f"{record['machine']['python']}; " + (f"pinned to CPU {pinning['cpus']}."
-             if pinning.get("pinned") else f"not pinned (CPUs {pinning.get('cpus')}).")]
-    if record["notes"]:
-        lines += ["", *(f"* {note}" for note in record["notes"])]
-    lines += ["", "**Targets**", "", targets_table(record["targets"])]
-    lines += ["", "**One env, `env.step`** (µs per step with a pre-sampled action, reset when "
-              "an episode ends; gym.make = TimeLimit, OrderEnforcing, PassiveEnvChecker; "
-              "ratios: peer time / our time through gym.make, > 1: ours faster)", "",
-              single_table(record["single_env"], record["unavailable"])]
-    if record["vector_env"]:
-        lines += ["", "**Vector env throughput** (env-steps/s · physics steps/s = env-steps/s × "
-                  "frame_skip; ours: `gym.make_vec(id, num_envs=N, vectorization_mode="
-                  "\"vector_entry_point\")`, Acrobot: `\"sync\"`; medians)", "",
-                  vector_table(record["vector_env"])]
-    return "\n".join(lines)
+    """The targets and the result tables of one run (printed on stdout)."""
+    return summary(record, ("numpy", "numba", "gymnasium", "mujoco"), {
+        "One env, env.step [µs] (gym.make and unwrapped; pre-sampled actions)": (
+            record["single_env"] + record["unavailable"],
+            ["env_id", "gym.make.median_us", "gym.make.min_us", "unwrapped.median_us",
+             "frame_skip", "per_physics_step_us", "first_step_s", "error"]),
+        "Vector env throughput": (record["vector_env"], [
+            "env_id", "mode", "num_envs", "env_steps_per_s", "physics_steps_per_s"]),
+    })
 
 
 def plot_step(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]],
@@ -173,11 +124,4 @@ def plot_vector(vector: Sequence[dict[str, Any]], targets: Mapping[str, float], 
     save_figure(fig, path)
 
 
-__all__ = [
-    "markdown_report",
-    "plot_step",
-    "plot_vector",
-    "short_name",
-    "single_table",
-    "vector_table",
-]
+__all__ = ["markdown_report", "plot_step", "plot_vector", "short_name"]

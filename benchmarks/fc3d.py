@@ -1,18 +1,7 @@
 """FC3D on every Siconos peer problem: time and residual of each method, to tolerance 1e-8.
 
-Usage (from the repository root)::
-
-    python -m benchmarks.fc3d --output benchmarks/results          # about 4 min
-    python -m benchmarks.fc3d --output /tmp/fc3d --quick           # problems with n <= 150
-
-Runs ``solve_fc3d`` with ``newton_ac``, ``nsgs``, ``hybrid`` (sparse Newton with a Levenberg
-shift chained with NSGS sweeps) and ``fixed_point_socp`` (De Saxce's fixed point on convex cone
-QPs solved by Clarabel, with a Newton polish that unloads duplicate contacts; needs the ``conic``
-extra) on each ``fc3d/*.dat`` file of the peer data, from r = 0. Each result's residual is
-recomputed with ``fc3d_residual``; a problem counts as solved when some method reports CONVERGED
-(residual <= 1e-8). A call shorter than 20 ms is repeated and its median time kept. Writes
-``fc3d.json`` and ``fc3d.png`` (time and residual per problem and method) and prints the
-Markdown table.
+``python -m benchmarks.fc3d [--output DIR] [--quick]`` (quick: n <= 150) writes ``fc3d.json`` and
+``fc3d.png``; a problem is solved when some method converges (residual recomputed).
 """
 
 from __future__ import annotations

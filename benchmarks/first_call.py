@@ -1,12 +1,4 @@
-"""First-call probe: run in a fresh interpreter, prints JSON of import and first-call times.
-
-The first call of a numba kernel compiles it (or loads it from numba's on-disk cache); later
-calls do not. ``python -m benchmarks.first_call`` times, in this order: importing our LCP
-package, importing QuantEcon's Lemke, then the first call of our compiled ``lemke_solve``, of
-``solve_lcp`` for each method (which adds the driver's own compiled helpers to the first of
-them) and of QuantEcon's ``lcp_lemke``, each on the same small problem. ``timing.probe_first_calls``
-runs it with an empty or the ordinary numba cache.
-"""
+"""First-call probe: run in a fresh interpreter, prints JSON of import and first-call times."""
 
 from __future__ import annotations
 

@@ -1,10 +1,4 @@
-"""The suite's headline table: every benchmark's target checks and the stress verdicts, in one.
-
-``write_headline(folder)`` reads whichever result files the folder holds (``engine.json``,
-``envs.json``, ``work_precision.json``, ``stress.json``; each benchmark writes its own), and
-writes ``headline.json`` and ``headline.md``: one row per target (benchmark, target, measured,
-threshold, met) and one row for the stress cases (passed of total, the failed ones named).
-"""
+"""The suite's headline table: every benchmark's target checks and the stress verdicts, in one."""
 
 from __future__ import annotations
 

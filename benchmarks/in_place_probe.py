@@ -1,10 +1,6 @@
-"""Run in a fresh interpreter by ``benchmarks.before_after``: the fastest in-place single step.
+"""Run in a fresh interpreter by ``before_after``: ``python -m benchmarks.in_place_probe MODEL``.
 
-``python -m benchmarks.in_place_probe MODEL`` (``manipulator``: arm from rest under a 0.1 N m
-torque, dt = 1 ms, brake released; ``diff_drive``: robot from rest under wheel torques (1, 0.4)
-N m, dt = 10 ms, turning): 1000 warm-up steps, then 300 batches of 200 ``InPlaceStepper.step()``
-calls; prints the minimum and the median µs per step over the batches. The minimum is the code's
-speed; the median moves with this VM's slow phases (about 2x, seconds long).
+Prints the minimum and median µs per ``InPlaceStepper.step()`` over 300 batches of 200 steps.
 """
 
 from __future__ import annotations

@@ -1,17 +1,7 @@
 """Benchmark problems: two seeded random LCP families and the Siconos peer LCP files.
 
-Families (every instance is reproducible from ``(SEED, family, n, instance)`` alone, so a
-problem does not depend on which grid it was generated for):
-
-* ``spd``: ``M = A A^T / n + 0.1 I`` with ``A`` standard normal, ``q ~ N(0, I)``. Symmetric
-  positive definite, so every method applies and the solution is unique.
-* ``contact``: a redundant-contact Delassus matrix. ``ceil(n / 6)`` planar rigid bodies (unit
-  mass and inertia, 3 dofs each) carry the n contacts; contact i touches body ``i mod nb`` and,
-  for odd i, also body ``i mod nb + 1`` from the other side. Each contact has a random unit
-  normal and random lever arms. ``W = J J^T`` has rank at most ``3 nb`` (about n / 2), so it is
-  regularized as constraint-force mixing does: ``M = W + 0.01 mean(diag W) I``;
-  ``q = J v`` with a free velocity ``v ~ N(0, I)``. PSD-plus-small-shift and badly conditioned,
-  as contact problems are: projected Gauss-Seidel needs about a thousand sweeps here.
+``spd``: ``M = A A^T / n + 0.1 I``; ``contact``: a redundant-contact Delassus matrix regularized
+as constraint-force mixing does. Every instance follows from ``(SEED, family, n, instance)``.
 """
 
 from __future__ import annotations
@@ -111,13 +101,5 @@ def peer_lcp_problems(root: Path | None = None) -> list[Problem]:
     return problems
 
 
-__all__ = [
-    "FAMILIES",
-    "SEED",
-    "Problem",
-    "contact_lcp",
-    "peer_data_dir",
-    "peer_lcp_problems",
-    "random_problem",
-    "spd_lcp",
-]
+__all__ = ["FAMILIES", "SEED", "Problem", "contact_lcp", "peer_data_dir", "peer_lcp_problems",
+           "random_problem", "spd_lcp"]

@@ -1,9 +1,6 @@
 """Reporting shared by every benchmark: Markdown tables, target checks, figures, the JSON record.
 
-A target check is a dict ``{target, comparison, threshold, unit, measured, met, note}``
-(``target_row``); ``comparison`` is ``"≤"``, ``"≥"`` or ``""`` (a comparison without a limit),
-``met`` is None when nothing was measured. Every benchmark's ``targets`` and the headline table
-(``benchmarks.headline``) use this one schema.
+A target check is ``{target, comparison, threshold, unit, measured, met, note}`` (``target_row``).
 """
 
 from __future__ import annotations
@@ -65,6 +62,31 @@ def markdown_table(rows: Iterable[Any], columns: Sequence[str] | None = None) ->
     """
     frame = pd.DataFrame(list(rows), columns=list(columns) if columns is not None else None)
     return frame.to_markdown(index=False, disable_numparse=True)
+
+
+def flat_table(rows: Iterable[Mapping[str, Any]], columns: Sequence[str] | None = None) -> str:
+    """Markdown of records: nested dicts become ``a.b`` columns, list fields are left out."""
+    frame = pd.json_normalize(list(rows))
+    keep = [c for c in (columns or frame.columns) if c in frame
+            and not frame[c].map(lambda v: isinstance(v, list)).any()]
+    return frame[keep].to_markdown(index=False, floatfmt=".3g")
+
+
+def summary(record: Mapping[str, Any], packages: Sequence[str],
+            sections: Mapping[str, Any]) -> str:
+    """A run's stdout report: run line, notes, targets, then per section title its table.
+
+    A section is a list of records (``flat_table``), a (records, columns) pair or ready text.
+    """
+    lines = [run_line(record, packages), *(f"* {note}" for note in record.get("notes") or [])]
+    if record.get("targets"):
+        lines += ["", "**Targets**", "", targets_table(record["targets"])]
+    for title, section in sections.items():
+        rows, columns = section if isinstance(section, tuple) else (section, None)
+        if rows:
+            text = rows if isinstance(rows, str) else flat_table(rows, columns)
+            lines += ["", f"**{title}**", "", text]
+    return "\n".join(lines)
 
 
 def save_figure(fig: Any, path: Path, dpi: int = 130) -> None:
@@ -164,18 +186,6 @@ def write_json(record: dict[str, Any], path: Path) -> None:
     path.write_text(json.dumps(record, indent=1, default=lambda v: v.item()) + "\n")
 
 
-__all__ = [
-    "format_number",
-    "format_ratio",
-    "format_residual",
-    "format_us",
-    "format_us_fine",
-    "json_safe",
-    "markdown_table",
-    "plt",
-    "run_line",
-    "save_figure",
-    "target_row",
-    "targets_table",
-    "write_json",
-]
+__all__ = ["flat_table", "format_number", "format_ratio", "format_residual", "format_us",
+           "format_us_fine", "json_safe", "markdown_table", "plt", "run_line", "save_figure",
+           "summary", "target_row", "targets_table", "write_json"]

@@ -1,18 +1,8 @@
 """LCP solver benchmark: work vs size for every method, and our Lemke against QuantEcon's.
 
-Usage (from the repository root; ``mdi-envs bench solvers`` runs it into benchmarks/results)::
-
-    python -m benchmarks.solvers --output results/bench
-    python -m benchmarks.solvers --output /tmp/bench --quick   # about 10 s, for tests
-
-Writes ``solvers.json``, ``solvers_time_vs_size.png``, ``solvers_residual_vs_size.png`` and
-``lemke_vs_quantecon.png`` to the output folder, prints progress lines on stderr and the
-Markdown results tables (the ones in ``benchmarks/README.md``) on stdout.
-
-The QuantEcon comparison times three entries interleaved on each problem: the public driver
-``solve_lcp(M, q, method="lemke")`` (input checks and residual check included), our compiled
-entry ``lemke_solve`` (neither) and QuantEcon's ``lcp_lemke``; the fixed cost of each is measured
-on two 2 x 2 problems (one needing two pivots, one with q >= 0 solved by z = 0).
+``python -m benchmarks.solvers [--output DIR] [--quick]`` writes ``solvers.json``,
+``solvers_{time,residual}_vs_size.png`` and ``lemke_vs_quantecon.png``. Lemke is timed through
+the driver ``solve_lcp`` and its compiled entry ``lemke_solve``, interleaved with QuantEcon's.
 """
 
 from __future__ import annotations
@@ -224,7 +214,7 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
     finish(record, log.elapsed)
     report.write_json(record, output / "solvers.json")
     log(f"done in {log.elapsed:.0f} s; wrote solvers.json and 3 plots to {output}")
-    return R.markdown_report(record, aggregates, summary, SIZE_STUDY_COLUMNS)
+    return R.markdown_report(record)
 
 
 def main(argv: Sequence[str] | None = None) -> None:

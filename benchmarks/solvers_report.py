@@ -9,15 +9,7 @@ from typing import Any
 import numpy as np
 from matplotlib.ticker import NullFormatter
 
-from benchmarks.report import (
-    format_ratio,
-    format_residual,
-    format_us,
-    markdown_table,
-    plt,
-    run_line,
-    save_figure,
-)
+from benchmarks.report import plt, save_figure, summary
 
 ENTRY_KEYS = ("driver", "kernel", "quantecon")
 """Keys of the three timed entries in each row of the QuantEcon comparison."""
@@ -59,49 +51,6 @@ def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, An
     return rows
 
 
-def _size_cell(row: dict[str, Any] | None) -> str:
-    """``time µs · iterations · max residual``, flagged when not every instance was solved."""
-    if row is None:
-        return "–"
-    cell = (f"{format_us(row['time_median_s'])} · {row['iterations_median']:g} · "
-            f"{format_residual(row['residual_max'], 0)}")
-    if row["solved"] < row["instances"]:
-        cell += f" **({row['solved']}/{row['instances']} solved)**"
-    return cell
-
-
-def size_tables(aggregates: Sequence[dict[str, Any]], entries: Sequence[str]) -> str:
-    """One Markdown table per family: rows n, columns entries, cells from ``_size_cell``."""
-    index = {(r["family"], r["n"], r["entry"]): r for r in aggregates}
-    blocks = []
-    for family in dict.fromkeys(r["family"] for r in aggregates):
-        sizes = sorted({r["n"] for r in aggregates if r["family"] == family})
-        instances = max(r["instances"] for r in aggregates if r["family"] == family)
-        rows = [{"n": str(n), **{ENTRY_TITLES.get(e, e): _size_cell(index.get((family, n, e)))
-                                 for e in entries}} for n in sizes]
-        blocks.append(f"**Work vs size, family `{family}`** (our methods through `solve_lcp`; "
-                      f"cells: median over {instances} instances of the median time per solve "
-                      "in µs · median iterations · largest residual)\n\n" + markdown_table(rows))
-    return "\n\n".join(blocks)
-
-
-def peer_table(rows: Sequence[dict[str, Any]]) -> str:
-    """Per-problem comparison of our Lemke (driver and compiled entry) with QuantEcon's."""
-    return markdown_table([{
-        "problem": r["name"], "n": str(r["n"]),
-        "driver µs": format_us(r["driver"]["time"]["median_s"]),
-        "lemke_solve µs": format_us(r["kernel"]["time"]["median_s"]),
-        "QuantEcon µs": format_us(r["quantecon"]["time"]["median_s"]),
-        "driver/QE": format_ratio(r["ratio_driver"]),
-        "lemke_solve/QE": format_ratio(r["ratio_kernel"]),
-        "residual ours": format_residual(r["kernel"]["outcome"]["residual"]),
-        "residual QE": format_residual(r["quantecon"]["outcome"]["residual"]),
-        "pivots ours": str(r["kernel"]["outcome"]["iterations"]),
-        "pivots QE": str(r["quantecon"]["outcome"]["iterations"]),
-        "status ours": r["kernel"]["outcome"]["status"],
-        "status QE": r["quantecon"]["outcome"]["status"]} for r in rows])  # fmt: skip
-
-
 def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """Median time ratios ours/QuantEcon over problem sets, for both of our entry points.
 
@@ -122,52 +71,29 @@ def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
             for name, members in sets.items() if members]
 
 
-def ratio_table(summary: Sequence[dict[str, Any]]) -> str:
-    """Markdown table of ``ratio_summary``."""
-    return markdown_table([{
-        "problem set": s["set"], "problems": str(s["problems"]),
-        "median driver / QuantEcon": format_ratio(s["median_ratio_driver"]),
-        "median lemke_solve / QuantEcon": format_ratio(s["median_ratio_kernel"])}
-        for s in summary])  # fmt: skip
-
-
-def fixed_cost_table(rows: Sequence[dict[str, Any]]) -> str:
-    """Markdown table of the n = 2 fixed-cost rows: median µs per call of each entry."""
-    def us(row: dict[str, Any], key: str) -> float:
-        return row[key]["time"]["median_s"]
-
-    return markdown_table([{
-        "problem": r["name"], "solve_lcp (driver) µs": format_us(us(r, "driver")),
-        "lemke_solve µs": format_us(us(r, "kernel")), "QuantEcon µs": format_us(us(r, "quantecon")),
-        "driver/QE": format_ratio(us(r, "driver") / us(r, "quantecon"))} for r in rows])
-
-
-def first_call_table(first: dict[str, Any]) -> str:
-    """Markdown table: entry x probe (warm / cold cache) of first-call milliseconds."""
-    probes = [p for p in first if "first_call_s" in first[p]]
-    if not probes:
-        return "(first-call probe failed: " + str(first) + ")"
-    return markdown_table([{
-        "entry": name,
-        **{f"first call, {p.replace('_', ' ')}": f"{first[p]['first_call_s'][name] * 1e3:.1f}"
-           for p in probes},
-        "second call": f"{first[probes[0]]['second_call_s'][name] * 1e3:.3f}"}
-        for name in first[probes[0]]["first_call_s"]])  # fmt: skip
-
-
-def markdown_report(record: dict[str, Any], aggregates: list[dict[str, Any]],
-                    summary: list[dict[str, Any]], entries: Sequence[str]) -> str:
-    """All result tables of the run, as printed to stdout."""
-    return "\n\n".join([
-        run_line(record, ("numpy", "numba", "quantecon")),
-        "**First call per entry** (fresh interpreter; ms):", first_call_table(record["first_call"]),
-        size_tables(aggregates, entries),
-        "**Lemke vs QuantEcon, per problem** (median time per solve; residuals recomputed with "
-        "`lcp_residual`; our pivots/status/residual are those of `lemke_solve`, which the driver "
-        "returns unchanged)", peer_table(record["quantecon_comparison"]["problems"]),
-        "**Median time ratio ours / QuantEcon** (< 1: ours faster)", ratio_table(summary),
-        "**Fixed cost per call at n = 2** (median µs per call, interleaved rounds)",
-        fixed_cost_table(record["fixed_cost"])])
+def markdown_report(record: dict[str, Any]) -> str:
+    """The result tables of one run (printed on stdout)."""
+    first = record["first_call"]
+    comparison = record["quantecon_comparison"]
+    return summary(record, ("numpy", "numba", "quantecon"), {
+        "First call per entry [s] (fresh interpreter)": [
+            {"probe": probe, **result.get("first_call_s", result)}
+            for probe, result in first.items()],
+        "Work vs size (median over instances; our methods through solve_lcp)": (
+            record["size_study"]["aggregates"], ["family", "n", "entry", "time_median_s",
+                                                 "iterations_median", "residual_max", "solved",
+                                                 "instances"]),
+        "Lemke vs QuantEcon per problem (median time per solve [s])": (comparison["problems"], [
+            "name", "n", "driver.time.median_s", "kernel.time.median_s",
+            "quantecon.time.median_s", "ratio_driver", "ratio_kernel",
+            "kernel.outcome.residual", "quantecon.outcome.residual",
+            "kernel.outcome.iterations", "quantecon.outcome.iterations",
+            "kernel.outcome.status", "quantecon.outcome.status"]),
+        "Median time ratio ours / QuantEcon (< 1: ours faster)": comparison["median_ratios"],
+        "Fixed cost per call at n = 2 [s]": (record["fixed_cost"], [
+            "name", "driver.time.median_s", "kernel.time.median_s",
+            "quantecon.time.median_s"]),
+    })
 
 
 def plot_by_entry(aggregates: Sequence[dict[str, Any]], entries: Sequence[str], path: Path,
@@ -239,10 +165,5 @@ def _ratio_label(row: dict[str, Any]) -> str:
     return label
 
 
-__all__ = [
-    "aggregate_size_study",
-    "markdown_report",
-    "plot_by_entry",
-    "plot_ratios",
-    "ratio_summary",
-]
+__all__ = ["aggregate_size_study", "markdown_report", "plot_by_entry", "plot_ratios",
+           "ratio_summary"]

@@ -1,18 +1,9 @@
-"""Start-up time: interpreter start to the first env step returned (``mdi-envs bench startup``).
+"""Start-up time: a fresh interpreter to its first env step returned (``mdi-envs bench startup``).
 
-For every registered id and for Gymnasium's Acrobot-v1 and MuJoCo's InvertedDoublePendulum-v5,
-each case runs ``benchmarks.startup_probe`` in a fresh interpreter and takes the wall-clock time
-from just before the process is started to the moment its first step returned: through
-``gym.make`` (single), ``gym.make_vec(id, num_envs=64)`` (vector) and an SB3 ``SubprocVecEnv``
-with 2 workers (subproc). With a warm kernel cache (filled by ``mdi-envs compile all``, whose
-time on the empty cache is recorded too) and, in the full run, with an empty one (cold: every
-kernel compiled). Warm cases are repeated, interleaved, and reported by their median.
-
-Writes ``startup.json`` and ``startup.png`` into ``--output`` and prints a Markdown table.
-``--quick`` (inside ``make test``) measures the warm single and vector cases once on the
-user's cache, after ``mdi-envs compile all``. ``--python-path DIR`` runs every probe on the
-package found in DIR (e.g. a checkout of an earlier commit, to measure "before").
-Full run: about 10 min on 2 cores.
+Each case runs ``startup_probe`` in a new process through ``gym.make``, ``gym.make_vec`` or an SB3
+``SubprocVecEnv``, warm (cache filled by ``mdi-envs compile all``) and, in the full run, cold;
+beside Acrobot-v1 and InvertedDoublePendulum-v5. Writes ``startup.json`` and ``startup.png``.
+``--python-path DIR`` runs the probes on the package in DIR.
 """
 
 from __future__ import annotations

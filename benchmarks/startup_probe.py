@@ -1,12 +1,7 @@
-"""Run in a fresh interpreter by ``benchmarks.startup``: create an env and take its first step.
+"""Run in a fresh interpreter by ``startup``: ``python -m benchmarks.startup_probe ENTRY ENV_ID``.
 
-``python -m benchmarks.startup_probe ENTRY ENV_ID`` with ENTRY ``single`` (``gym.make``),
-``vector`` (``gym.make_vec(..., num_envs=64)``) or ``subproc`` (Stable-Baselines3
-``SubprocVecEnv`` with 2 workers); prints one JSON line with the wall-clock time (``time.time()``,
-seconds since the epoch) at which the first step returned, and the time spent in each phase.
-ENV_ID ``numba-floor`` (entry ``single``) measures the floor of any numba-compiled env instead:
-import gymnasium and numba, then the first call of one trivial ``cache=True`` kernel loaded
-from numba's disk cache (numba initializes its compiler on that first load).
+Prints one JSON line: the time (``time.time()``) the first step returned and each phase's time.
+ENV_ID ``numba-floor``: one trivial cached numba kernel instead (the floor of any numba env).
 """
 
 from __future__ import annotations

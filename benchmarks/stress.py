@@ -1,12 +1,8 @@
 """``mdi-envs bench stress``: run the stress cases of ``tests/stress`` and write their record.
 
-The cases (Zeno balls, brake toggling, dt and mu sweeps, overdrive, degenerate LCPs, long
-horizons, each with pass/fail criteria) are pytest cases marked ``stress``; this module runs them
-with ``pytest.main`` (the full configuration, or with ``--quick`` the quick one:
-``MDI_ENVS_STRESS=quick``), collects the record each case attaches, and writes ``stress.json``
-(every case: parameters, metrics, criteria ``{value, limit, relation, passed}``; machine info; run
-time) and ``stress.png`` (each criterion's margin value / limit, one row per case), and prints the
-Markdown table. Exits with 1 if any case fails.
+Runs the ``stress`` pytest cases (``--quick``: ``MDI_ENVS_STRESS=quick``), collects the record
+each attaches (parameters, metrics, criteria) into ``stress.json`` and their margins into
+``stress.png``. Exits with 1 if any case fails.
 """
 
 from __future__ import annotations

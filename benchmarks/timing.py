@@ -1,21 +1,7 @@
 """Wall-clock timing: interleaved rounds with adaptive repeats, first-call probes, machine info.
 
-``time_interleaved`` runs its callables in rounds A B C, A B C, ... so that a change of machine
-load (the benchmark machine is shared) hits every callable alike. Each callable first gets one
-untimed warm-up call (whose duration sizes the rest), then, per round, a batch of ``number``
-back-to-back calls (``timeit.Timer.timeit``, garbage collection left on) long enough
-(``min_batch_s``) for the clock to resolve it; the reported time per call is the median over
-rounds of batch time / number.
-
-Why not pytest-benchmark or pyperf: both time one benchmark's rounds (pyperf: its worker
-processes) before the next benchmark's, so a slow phase of this shared VM (seconds long, about
-2x) lands on one side of a comparison. Measured with two identical compiled no-op callables A and
-B at load 9-15 (``time_interleaved`` with one callable at a time, as those tools do, against
-both interleaved; 30 repetitions, 0.5 s budget each): one after the other, A/B ranged over
-0.56-1.34 (worst error 44 %); interleaved, over 0.86-1.14 (worst 14 %; the median error was
-7 % interleaved against 2 % consecutive). Every speed target here is a ratio or a comparison
-against a peer measured in the same run, so the worst case matters: the interleaved timer is
-kept, and ``before_after`` alternates the two trees for the same reason.
+``time_interleaved`` runs its callables in rounds A B C, A B C, ... (after one untimed warm-up
+call each), so a phase of load on the shared machine hits every entry it compares alike.
 """
 
 from __future__ import annotations
@@ -294,19 +280,6 @@ def machine_info(packages: tuple[str, ...] = VERSIONED_PACKAGES) -> dict[str, An
     }
 
 
-__all__ = [
-    "VERSIONED_PACKAGES",
-    "Progress",
-    "Timed",
-    "TimingPlan",
-    "arguments",
-    "checkpoint",
-    "finish",
-    "load_average",
-    "load_text",
-    "machine_info",
-    "probe_first_calls",
-    "seconds",
-    "speed_probe",
-    "time_interleaved",
-]
+__all__ = ["VERSIONED_PACKAGES", "Progress", "Timed", "TimingPlan", "arguments", "checkpoint",
+           "finish", "load_average", "load_text", "machine_info", "probe_first_calls", "seconds",
+           "speed_probe", "time_interleaved"]

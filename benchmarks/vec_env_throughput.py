@@ -1,24 +1,8 @@
-"""PPO training throughput through the batched adapter vs SB3's DummyVecEnv and SubprocVecEnv.
+"""PPO training throughput: the batched adapter vs SB3's DummyVecEnv and SubprocVecEnv.
 
-The same PPO (the shipped settings of ``baselines/hyperparams/ppo.yml``: 64 copies, rollouts of
-64 x 256 steps, 10 epochs, torch on one thread) trains for ``--rollouts`` rollouts on one env
-id through three vector envs of ``--num-envs`` copies:
-
-- ``batched adapter``: ``baselines.vec_env.make_vec_env`` (one compiled call steps every copy)
-  in ``VecMonitor``, what ``mdi-envs train`` uses;
-- ``DummyVecEnv``: SB3's ``make_vec_env`` over ``gym.make`` copies (each in ``Monitor``), what
-  ``python -m rl_zoo3.train`` uses by default;
-- ``SubprocVecEnv``: the same copies, one worker process each (``--vec-env subproc`` in
-  rl-zoo3), started by ``fork`` so that the 64 workers need no interpreter start-up or import
-  of their own (the default ``forkserver`` would import torch and the env in each).
-
-Per vector env: the set-up time (creating the copies, workers included), the training time and
-environment steps per second over it, and its split into rollout collection (env steps and
-policy inference; steps per second) and PPO updates (a callback times each rollout).
-
-Writes ``vec_env_throughput.json`` and ``vec_env_throughput.png`` into ``--output`` and prints
-a Markdown table. ``python -m benchmarks.vec_env_throughput`` (manipulator, 64 copies,
-20 rollouts = 327,680 steps each): about 3 min on 2 cores. Needs the ``rl`` extra.
+``python -m benchmarks.vec_env_throughput`` trains the shipped PPO settings for ``--rollouts``
+rollouts through each vector env and writes ``vec_env_throughput.json`` and ``.png``: set-up,
+steps per second, rollout and update time. Needs the ``rl`` extra.
 """
 
 from __future__ import annotations

@@ -1,71 +1,9 @@
-"""Work-precision benchmark: error against wall time per scene, for every integrator and MuJoCo.
+"""Work-precision benchmark: error against wall time per scene, ours, event-driven and MuJoCo.
 
-Usage (from the repository root)::
-
-    python -m benchmarks.work_precision --output benchmarks/results
-    python -m benchmarks.work_precision --output /tmp/wp --quick   # ball + manipulator only
-
-Writes ``work_precision.json`` (every point, the target checks, machine information),
-``work_precision_<scene>.png`` (log-log error against wall time, one line per series) and
-``work_precision_ball_convergence.png`` (ball error against dt with an O(dt) slope) to the
-output folder; progress lines go to stderr, the Markdown report (``work_precision_report``) to
-stdout. The full run takes a few minutes (about half of it numba compilation); ``--quick``
-runs the ball and the manipulator at three time steps and one event-driven tolerance.
-
-**Scenes and error measures** (errors are absolute in SI units unless said relative):
-
-* ``ball``: the default ball (eps = 0.8) dropped from rest at D gaps h0 ~ U(0.9, 1.1) m (seeded)
-  until its fourth impact. Closed form: apex k at eps^(2k) h0, impact k + 1 at
-  t1 (1 + 2 sum_{j<=k} eps^j), t1 = sqrt(2 h0 / g). Measured apex k: the largest sampled gap
-  y - r at the k-th sign change of y' from + to - (the event integrator's apex events). The
-  error of one drop is the largest relative apex error over bounces 1-3,
-  max_k |apex_k - eps^(2k) h0| / (eps^(2k) h0) [-]; a point's ``error`` is its mean over the D
-  drops (``error_max`` the largest). The runs last 1.25 times the exact fourth impact of the
-  highest drop, before the Zeno point. Secondary: impacts 2-4 as landing times of the simulated
-  flights, t_j + (y'_j + sqrt(y'_j^2 + 2 g (y_j - r))) / g from the apex sample j, mean over
-  drops of the largest |error| [s] (``impact_time_error_s``).
-* ``slope``: the block on a slope, three cases against their closed forms: ``sliding``
-  (theta = 0.5, mu = 0.5, from rest, 1 s: s = a T^2 / 2, s' = a T, a = g (sin theta -
-  mu cos theta)), ``sticking`` (mu = 0.6 > tan theta: s = s' = 0) and ``stick_slip`` (a
-  triangular push along the slope: stick, slide, stick; the closed form of
-  ``tests/stepping/test_moreau_jean_block.py``). Error: max(|s(T) - s_exact|, |s'(T) -
-  s'_exact|) [m, m/s]; for ``stick_slip`` also the largest |s'_k - s'(t_k)| over the steps.
-* ``manipulator``: from rest, the paper's brake schedule (engaged 0, 1.072, 2.392 s, released
-  0.412, 1.84 s) with a bang-bang torque +-1 N m switching at 2.264 s, to 4.528 s (the scenario
-  of ``tests/stepping/test_event_driven.py``). Reference: the event-driven integrator at rtol
-  1e-12, atol 1e-14 (its own error estimated against rtol 1e-11). Error: the largest
-  |state - reference| over (alpha, beta, alpha', beta') [rad, rad/s] and over the sample
-  times, multiples of 4 ms (velocities are left limits u(t-) in both); ``final_error`` at 4.528 s.
-* ``diff_drive``: from rest, torques (1, 0.6), (3, -3), (-0.5, -0.5) N m for 0.5 s each (rolling,
-  both wheels slipping, braking). Reference: Moreau-Jean at dt_ref = 5e-6 s, whose own error is
-  estimated by its difference from a run at 2 dt_ref. Error: the largest |final state -
-  reference| over (x, y, phi, psi_L, psi_R) and their rates [m, rad, m/s, rad/s].
-
-**Series.** Moreau-Jean over a range of dt, once per complementarity method the compiled step can
-use (``StepShortcuts.direct_solve_max_size``: ``enumerative`` for LCPs of <= 3 variables, the
-default, or ``lemke`` always; PGS and Newton-FB are not selectable inside the step). The ideal
-brake is an equality row eliminated by a Schur complement (no LCP: one series), and the
-diff-drive's spatial friction has one solver (semismooth Newton on Alart-Curnier: one series).
-The event-driven integrator (``EventDrivenIntegrator``, DOP853) at rtol in {1e-4, ..., 1e-10},
-atol = 1e-2 rtol, where it applies (the ball before its Zeno point, the manipulator; it is
-frictionless, so not the slope or the robot). MuJoCo (``work_precision_mujoco``) on the ball
-and on the arm.
-
-**Wall time** [s]: the whole simulation of one trajectory (the ball: drop 0), best of 3-15
-repeats (as many as fit in 0.5 s; 3 in ``--quick``) after an untimed warm-up call; compilation
-is done before and reported apart. Our fastest honest path: one ``step_batch`` call (N = 1,
-check_inputs=False, preallocated outputs) with ``num_substeps`` = all steps (ball, slope), or
-one call per constant-command phase (manipulator, robot); per-step calls only where the input
-changes every step (``stick_slip``). MuJoCo: one ``mj_step(model, data, nstep)`` call per
-phase. Errors needing more than the final state are measured on a replay of the same run that
-stops at the samples (every step for the ball, every 4 ms for the arm); its final state equals
-the timed run's (``replay_difference``, 0 here). The machine is shared: times move by up to ~2x
-between runs, errors not at all.
-
-**Targets** (reported and never enforced: ``main`` returns 0 when they are missed):
-ball apex error <= 1e-3 relative at dt = 1e-3 s; ball error O(dt) (fitted order >= 0.8); at
-equal wall time MuJoCo's ball error >= 100x ours (``work_precision_report.equal_time_comparison``);
-the ideal brake stops the relative motion in one step (``benchmarks.engine.brake_stop_study``).
+``python -m benchmarks.work_precision [--output DIR] [--quick]`` writes ``work_precision.json``,
+``work_precision_<scene>.png`` and ``work_precision_ball_convergence.png``. Scenes and error
+measures: ball apexes against the closed form, slope cases against theirs, the manipulator
+against the event-driven reference, the robot against a fine step (docs/guide/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -971,17 +909,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 1 if record.get("failed_sections") else 0
 
 
-__all__ = [
-    "FULL",
-    "QUICK",
-    "WorkPrecisionConfig",
-    "ball_errors",
-    "evaluate_targets",
-    "main",
-    "observed_order",
-    "run",
-    "wall_time",
-]
+__all__ = ["FULL", "QUICK", "WorkPrecisionConfig", "ball_errors", "evaluate_targets", "main",
+           "observed_order", "run", "wall_time"]
 
 
 if __name__ == "__main__":

@@ -260,11 +260,5 @@ class MujocoArmRun:
         return self.state(), None if samples is None else np.array(samples)
 
 
-__all__ = [
-    "BALL_TIMECONST",
-    "CALIBRATION_DROP",
-    "MujocoArmRun",
-    "MujocoBall",
-    "calibrate_dampratio",
-    "formula_dampratio",
-]
+__all__ = ["BALL_TIMECONST", "CALIBRATION_DROP", "MujocoArmRun", "MujocoBall",
+           "calibrate_dampratio", "formula_dampratio"]

@@ -1,9 +1,4 @@
-"""Reporting of ``benchmarks.work_precision``: equal-time comparison, Markdown tables, plots.
-
-``equal_time_comparison`` reads MuJoCo's ball error off its Pareto front at each of our wall
-times; ``markdown_report`` prints the targets and one table per scene; ``plot_all`` draws one
-error-vs-wall-time diagram per scene and the ball's convergence plot.
-"""
+"""Reporting of ``benchmarks.work_precision``: equal-time comparison, tables and plots."""
 
 from __future__ import annotations
 
@@ -15,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.engine_report import brake_stop_table
+from benchmarks.engine_report import brake_rows
 from benchmarks.report import format_number as _format
-from benchmarks.report import markdown_table, plt, run_line, save_figure, targets_table
+from benchmarks.report import plt, save_figure, summary
 
 ERROR_FLOOR = 1e-17
 """Exactly-zero errors are drawn at this value on log axes."""
@@ -148,106 +143,23 @@ def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
     return result
 
 
-# ---------------------------------------------------------------------------------- Markdown
-def _details(p: Mapping[str, Any]) -> str:
-    """The point's secondary measurements as short text."""
-    parts = []
-    if p.get("error_max") is not None:
-        parts.append(f"worst drop {_format(p['error_max'])}")
-    if p.get("impact_time_error_s") is not None:
-        parts.append(f"impact times {_format(p['impact_time_error_s'])} s")
-    if p.get("final_error") is not None:
-        parts.append(f"final {_format(p['final_error'])}")
-    if p.get("speed_error") is not None:
-        parts.append(f"speed {_format(p['speed_error'])}")
-    if p.get("effective_restitution") is not None:
-        parts.append(f"ε_eff {p['effective_restitution']:.4f} (dampratio "
-                     f"{p['dampratio']:.4f})")
-    if p.get("worst_solver_status") not in (None, "CONVERGED"):
-        parts.append(f"solver {p['worst_solver_status']}")
-    if p.get("replay_difference"):
-        parts.append(f"replay differs by {_format(p['replay_difference'])}")
-    if p["status"] != "ok":
-        parts.append(p["status"])
-    return "; ".join(parts)
-
-
-def scene_table(points: Sequence[Mapping[str, Any]]) -> str:
-    """Markdown: series, dt or rtol, wall time [ms], error, details."""
-    rows = [[series_title(p["series"]), f"{p['parameter']} = {p['value']:g}",
-             "–" if p["wall_time_s"] is None else _format(p["wall_time_s"] * 1e3),
-             _format(p.get("error")), _details(p)]
-            for p in points]
-    return markdown_table(rows, ["series", "step / tolerance", "wall time ms", "error", "details"])
-
-
-def comparison_table(comparison: Mapping[str, Any]) -> str:
-    """Markdown: our dt, wall time, our error, MuJoCo's there, how, ratio."""
-    rows = [[f"{r['dt']:g}", _format(r["wall_time_s"] * 1e3), _format(r["error"]),
-             _format(r["mujoco_error"]), r["how"], _format(r["ratio"])]
-            for r in comparison["rows"]]
-    return markdown_table(rows, ["our dt [s]", "wall time ms", "our error", "MuJoCo error there",
-                                 "how", "MuJoCo / ours"])
-
-
 def markdown_report(record: Mapping[str, Any]) -> str:
-    """The targets, the equal-time comparison and one table per scene."""
-    lines = [run_line(record, ("numpy", "numba", "scipy", "mujoco"))]
-    if record["notes"]:
-        lines += ["", *(f"* {note}" for note in record["notes"])]
-    lines += ["", "**Targets** (reported, not enforced)", "", targets_table(record["targets"])]
-    comparison = record.get("equal_time")
-    if comparison and comparison["rows"]:
-        lines += ["", "**Ball: MuJoCo's error / ours at equal wall time.** MuJoCo's ball points "
-                  "(both dampratio series; failed runs left out) are reduced to their Pareto "
-                  "front; at each of our wall times its error is interpolated linearly in (log "
-                  "time, log error) between the two front points around it. Where ours is "
-                  "faster than MuJoCo's fastest front point, that point's error is used "
-                  "(clamped: MuJoCo gets more time than ours, so the ratio is a lower bound); "
-                  "beyond MuJoCo's slowest point nothing is compared. The target is judged on "
-                  "the equal-time (interpolated) ratios, or on the lower bounds when there are "
-                  f"none. Result: {comparison['summary']}.", "", comparison_table(comparison)]
-    if record["compile"]:
-        rows = [[c["model"], c["method"], f"{c['first_step_batch_s']:.1f}"]
-                for c in record["compile"]]
-        lines += ["", "**Compile time** (first step_batch call per kernel, excluded from every "
-                  "wall time)", "", markdown_table(rows, ["model", "method", "seconds"])]
-    for scene, title in SCENE_TITLES.items():
-        points = [p for p in record["points"] if p["scene"] == scene]
-        if points:
-            lines += ["", f"**{title}**", "", scene_table(points)]
-            lines += _reference_lines(scene, record)
-    lines += ["", "Timed paths: " + "; ".join(
-        f"`{k}` = {v}" for k, v in record["timed_paths"].items()) + "."]
-    if record.get("brake_stop"):
-        lines += ["", "**Brake stop** (`benchmarks.engine.brake_stop_study`, dt = 1e-3 s: "
-                  "relative velocity 1 rad/s, link 1 at rest, no torque; then the brake "
-                  "engages)", "", brake_stop_table(record["brake_stop"])]
-    return "\n".join(lines)
-
-
-def _reference_lines(scene: str, record: Mapping[str, Any]) -> list[str]:
-    """The scene's reference description or calibration table, if any."""
-    ref = record["references"].get(scene)
-    if scene == "manipulator" and ref:
-        return ["", f"Reference: event-driven, rtol {ref['rtol']:g}, atol {ref['atol']:g} "
-                f"({ref['wall_time_s']:.2f} s); its difference from rtol {ref['check_rtol']:g} "
-                f"is {ref['self_difference']:.1e} over the {ref['samples']} samples."]
-    if scene == "diff_drive" and ref:
-        return ["", f"Reference: Moreau–Jean at dt_ref = {ref['time_step']:g} s "
-                f"({ref['wall_time_s']:.1f} s, solver {ref['worst_status']}); its difference from "
-                f"dt = {ref['check_time_step']:g} s is {ref['self_difference']:.1e} (≈ its own "
-                "error for a first-order method)."]
-    if scene == "ball" and record.get("mujoco_ball_calibration"):
-        rows = [[series_title(c["series"]), f"{c['dt']:g}", f"{c['dampratio']:.5f}",
-                 _format(c["effective_restitution"]), c["note"]]
-                for c in record["mujoco_ball_calibration"]]
-        first = record["mujoco_ball_calibration"][0]
-        return ["", f"MuJoCo ball contact: solref (timeconst {first['solref'][0]:g} s, "
-                "dampratio), solimp (" + ", ".join(f"{x:g}" for x in first["solimp"][:3])
-                + "); effective restitution = sqrt(rebound apex / drop) of a 0.5 m drop:", "",
-                markdown_table(rows, ["series", "dt [s]", "dampratio", "ε_eff", "note"])]
-    return []
+    """The targets, the equal-time comparison, the compile times and one table per scene."""
+    comparison = record.get("equal_time") or {}
+    columns = ["series", "parameter", "value", "wall_time_s", "error", "error_max",
+               "final_error", "speed_error", "impact_time_error_s", "status"]
+    return summary(record, ("numpy", "numba", "scipy", "mujoco"), {
+        "Ball: MuJoCo's error / ours at equal wall time (MuJoCo's Pareto front interpolated "
+        f"in log-log; clamped: a lower bound). {comparison.get('summary', '')}":
+            comparison.get("rows"),
+        "Compile time [s] (first step_batch per kernel, excluded from every wall time)":
+            record["compile"],
+        **{title: ([p for p in record["points"] if p["scene"] == scene], columns)
+           for scene, title in SCENE_TITLES.items()},
+        "References": [{"scene": k, **v} for k, v in record["references"].items()],
+        "MuJoCo ball calibration": record.get("mujoco_ball_calibration"),
+        "Brake stop (dt = 1e-3 s)": brake_rows(record.get("brake_stop")),
+    })
 
 
 # ------------------------------------------------------------------------------------- plots
@@ -339,15 +251,5 @@ def plot_all(points: Sequence[Mapping[str, Any]], scenes: Sequence[str], output:
     return names
 
 
-__all__ = [
-    "ERROR_FLOOR",
-    "SCENE_TITLES",
-    "SERIES_TITLES",
-    "TIMED_PATHS",
-    "equal_time_comparison",
-    "interpolate_front",
-    "markdown_report",
-    "pareto_front",
-    "plot_all",
-    "series_title",
-]
+__all__ = ["ERROR_FLOOR", "SCENE_TITLES", "SERIES_TITLES", "TIMED_PATHS", "equal_time_comparison",
+           "interpolate_front", "markdown_report", "pareto_front", "plot_all", "series_title"]
