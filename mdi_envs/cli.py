@@ -19,8 +19,8 @@ distribution's metadata, e.g. in ``pyproject.toml``::
   arguments and sets the handler: ``parser.set_defaults(handler=run)``, where
   ``run(args: argparse.Namespace) -> int`` returns the exit code.
 * The module holding the function (the package's ``cli`` module) is imported only when its
-  subcommand runs or its ``--help`` is asked; ``mdi-envs --help`` and ``--version`` list the
-  plug-ins by entry-point name and import none of them. The module imports its heavy
+  subcommand runs or its ``--help`` is asked: ``mdi-envs --help`` lists the plug-ins by
+  entry-point name, and neither it nor ``--version`` imports one. The module imports its heavy
   dependencies inside its handler, so that its own ``--help`` stays quick.
 * Entry points are read from the installed metadata: after adding or renaming one, reinstall
   (``pip install --no-deps -e .``).
