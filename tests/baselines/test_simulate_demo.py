@@ -44,7 +44,9 @@ def test_demo_shows_envs_references_and_the_comparison(
     for name in ("manipulator_time", "diff_drive_time", "diff_drive_effort"):
         line = next(line for line in out.splitlines() if line.startswith(f"{name} (mdi_envs/"))
         assert "success True" in line and (tmp_path / f"{name}.gif").stat().st_size > 1000
-    assert "| BlockableManipulator-v0 | time | optimal (open loop) |" in out
+    rows = [line for line in out.splitlines() if line.startswith("| BlockableManipulator-v0 ")]
+    for controller in ("optimal (open loop)", "MPC (shrinking horizon)", "HybridPPO"):
+        assert any(f"| {controller} " in row for row in rows), controller
     assert "mdi_envs/BlockableManipulator-v0 (time) HybridPPO seed" in out
     assert "mdi_envs/DiffDriveRobot-v0 (effort) PPO seed" in out
     assert len(list(tmp_path.glob("*_seed*.gif"))) == 3
