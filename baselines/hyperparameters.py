@@ -13,45 +13,10 @@ must be ``MlpPolicy``; every other key is an SB3 constructor argument (``algo_kw
 Algorithms: SB3's PPO and SAC and sb3-contrib's TQC and CrossQ on the default flattened Box action
 spaces, and ``HybridPPO`` (``baselines.hybrid_ppo``: PPO with a categorical brake x Gaussian torque
 policy) on the manipulator's native ``action_mode="hybrid"`` space ``Tuple(Discrete(2), Box(-1, 1,
-(1,)))``; rl-zoo3 trains it through ``baselines.zoo``. Choices shared by every entry:
-
-- ``gamma = 0.99`` for every algorithm. The env's shaping term is
-  ``shaping_discount * Phi(s') - Phi(s)`` with Phi = -distance; every entry sets
-  ``shaping_discount = 1.0`` except the manipulator's PPO, shipped with 0.99 = gamma. With
-  1.0 the shaping telescopes to Phi(s_T) - Phi(s_0) per episode, so the episodic
-  (undiscounted) objective is unchanged; with gamma < 1 it pays (1 - gamma) * distance per
-  step for standing still, and the gamma-shaped HybridPPO and robot "time" runs settled there
-  (0 % success at 5 x 10^6 steps) where the same settings with 1.0 reached 100 %.
-- Diff drive "effort" PPO: ``goal_weight = 1000`` (the weight of the distance at the
-  horizon's end) with ``normalize_reward`` (SB3's ``VecNormalize`` on the rewards only, during
-  training; the policy never sees them). Without normalization, 5 x 10^6 steps: the env's
-  default 10 stopped ~0.3 m short using 0.43 of the optimum's effort; 100 stopped 0.06-0.07 m
-  short (effort 1.27x); 300 and 1000 ended 2.1 and 1.7 m away, their returns (down to -10^4)
-  swamping the value function: 0 % success each (tolerance 0.05 m). SAC: ``goal_weight`` 100.
-- PPO with many copies (64): the batched env steps them in one compiled call, so a rollout of
-  64 x 256 = 16384 steps costs about as much as a few hundred single-env steps; minibatches
-  of 2048, 10 epochs, GAE lambda 0.95, clip 0.2, no entropy bonus, 2 x 64 tanh MLPs (SB3's
-  defaults otherwise, as in rl-zoo's continuous-control settings).
-- HybridPPO: exactly the PPO settings (no per-algorithm tuning), only the action space differs.
-- The off-policy algorithms (SAC; sb3-contrib's TQC and CrossQ) share one setting: 8 copies, 2
-  gradient steps per 8 transitions (replay ratio 1/4), 10-step returns (SB3's ``n_steps``),
-  5000 random warm-up steps, batch 256, 10^6 buffer, 2 x 256 ReLU MLPs (CrossQ's critics too,
-  not its default 2 x 1024: ~150 ms per gradient step here), automatic entropy tuning, each
-  algorithm's own learning rate; on "effort" PPO's reward (``goal_weight`` 1000, rewards
-  normalized). A SAC gradient step at 2 x 256 costs ~10 ms on this CPU (one thread), TQC and
-  CrossQ ~16-18 ms. The 10-step returns are what made SAC learn: with 1-step targets (64
-  copies, ratio 1/16, 10^6 steps) SAC reached 0 % on every objective and CrossQ stood still on the
-  robot's time objective. Our reading, not tested further: one 0.05 s step of torque changes the
-  shaped reward too little for a 1-step target to carry the gain of a maneuver.
-- Budgets, the ones of the shipped policies (``baselines/trained``): PPO 10^7 steps on the
-  manipulator, 4 x 10^6 on diff drive "time", 5 x 10^6 on "effort", HybridPPO 5 x 10^6; the
-  off-policy algorithms 3 x 10^5 on the manipulator, 2 x 10^5 on the diff drive (what fits a
-  session's seed grid on the 2-core machine: PPO runs at about 3-15 k steps/s there, SAC at
-  ~200-400). Episodes: manipulator up to 500 steps of 0.02 s, the optimum
-  takes about 228; diff drive "time" up to 200 steps of 0.05 s, "effort" exactly 81.
-  Untuned starting points: the shipped results say how far they get.
-- Seed ``DEFAULT_SEED`` = 0 (rl-zoo3 takes it from ``--seed``, not from the file);
-  ``train(..., seed=...)`` overrides it.
+(1,)))``; rl-zoo3 trains it through ``baselines.zoo``. Why the settings are what they are
+(shaping discount, the effort reward, 10-step returns of the off-policy algorithms, budgets) is
+in the baselines guide, ``docs/guide/baselines.md``. The seed is ``DEFAULT_SEED`` = 0 (rl-zoo3
+takes it from ``--seed``, not from the file).
 """
 
 from __future__ import annotations
