@@ -1,17 +1,18 @@
-# Two entry points: `make demo` (the main job) and `make test`. Each creates .venv and installs
-# what it needs. CI sets TORCH_SPEC=torch==2.13.0 so that pip takes the local CPU wheel before
-# anything can pull the CUDA build; ordinary users leave it empty and get torch the normal way
-# when they install the `rl` extra. Both first compile every env kernel into the disk cache
-# (`mdi-envs compile all`), so that the processes after it start warm. The tests run on every
-# core (pytest-xdist); --dist loadfile keeps each file on one worker, so that a module's fixture
-# (the kernel-cache tests compile into an empty cache) runs once.
+# Entry points: `make demo` (the main job), `make test` (every test, then the quick benchmarks)
+# and `make test-fast` (the inner loop: the tests not marked slow). Each creates .venv and
+# installs what it needs. CI sets TORCH_SPEC=torch==2.13.0 so that pip takes the local CPU wheel
+# before anything can pull the CUDA build; ordinary users leave it empty and get torch the normal
+# way when they install the `rl` extra. Each first compiles every env kernel into the disk cache
+# (`mdi-envs compile all`), so that the processes after it start warm. The tests run on every core
+# (pytest-xdist); --dist loadfile keeps each file on one worker, so that a module's fixture (the
+# kernel-cache tests compile into an empty cache) runs once.
 
 PYTHON ?= python3
 VENV ?= .venv
 TORCH_SPEC ?=
 BIN := $(VENV)/bin
 
-.PHONY: demo test docs bench lint clean
+.PHONY: demo test test-fast docs bench lint clean
 
 # Install the package in editable mode with the given extras, once per extras set and pyproject.
 $(VENV)/.installed-%: pyproject.toml
@@ -29,6 +30,12 @@ test: $(VENV)/.installed-test
 	$(BIN)/mdi-envs compile all
 	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=10
 	$(BIN)/python -m mdi_envs bench --quick --skip stress
+
+# The inner loop while editing: every test but those marked slow (training, optimisation,
+# full-size solver and benchmark studies), the same as `pytest -m "not slow"`.
+test-fast: $(VENV)/.installed-test
+	$(BIN)/mdi-envs compile all
+	$(BIN)/python -m pytest -q -m "not slow" -n auto --dist loadfile --durations=10
 
 # The docs site (MkDocs Material + mkdocstrings) into site/; strict: a broken link or reference
 # fails. Its generated pages read the committed JSON and parse the sources (nothing compiles).
