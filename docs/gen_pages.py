@@ -272,17 +272,17 @@ def comparison_page() -> None:
 
 
 def trained_rows() -> list[dict[str, Any]]:
-    """One row per shipped policy, from its ``STEM.json``."""
+    """One row per shipped policy, from its ``STEM.json`` (``baselines.train.read_training``)."""
+    from baselines.train import read_training
+
     rows = []
     for path in sorted((ROOT / "baselines" / "trained").glob("*.json")):
-        run = load(path)
-        evaluation = run.get("evaluation") or {}
-        rows.append({"policy": path.stem, "steps": run.get("num_timesteps"),
-                     "copies": run.get("num_envs"),
-                     "wall time [min]": run["wall_time_s"] / 60 if "wall_time_s" in run else None,
-                     "training success": (run.get("train_last100") or {}).get("success_rate"),
-                     "evaluation success": evaluation.get("success_rate"),
-                     "commit": str(run.get("commit", ""))[:7]})
+        run = read_training(path)
+        rows.append({"policy": path.stem, "steps": run.num_timesteps, "copies": run.num_envs,
+                     "wall time [min]": run.wall_time_s / 60,
+                     "training success": run.train_last100.success_rate,
+                     "evaluation success": run.evaluation.success_rate,
+                     "commit": (run.commit or "")[:7]})
     return rows
 
 
