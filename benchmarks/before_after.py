@@ -7,7 +7,6 @@ interpreters, and writes the medians and ratios to ``before_after.json`` and ``.
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -19,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from benchmarks import report
-from benchmarks.timing import Progress, machine_info
+from benchmarks.timing import Progress, arguments, machine_info
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = (("engine", "engine.json"), ("envs", "envs.json"))
@@ -42,10 +41,7 @@ ARGUMENTS = {"engine": ("--quick", "--models", "manipulator,diff_drive"), "envs"
 
 
 def _harness(tree: Path, scratch: Path) -> Path:
-    """A folder with ``tree``'s packages and this tree's ``benchmarks``.
-
-    So the same measuring code runs on both trees (symbolic links, in ``scratch``).
-    """
+    """A folder with ``tree``'s packages and this tree's ``benchmarks``."""
     folder = scratch / f"harness-{abs(hash(str(tree)))}"
     if not folder.exists():
         folder.mkdir()
@@ -146,12 +142,10 @@ def _plot(rows: list[dict[str, Any]], path: Path) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns 1 if a target got slower than the limit."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--before", type=Path, required=True,
-                        help="a checkout of the earlier commit")
-    parser.add_argument("--rounds", type=int, default=2, help="alternations (default 2)")
-    parser.add_argument("--output", type=Path, default=Path("benchmarks/results"))
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, ("--before", {"type": Path, "required": True,
+                                                  "help": "a checkout of the earlier commit"}),
+                     ("--rounds", {"type": int, "default": 2, "help": "alternations"}),
+                     quick=False)
     if not (args.before / "mdi_envs" / "__init__.py").exists():
         raise SystemExit(f"--before {args.before}: no mdi_envs package there")
     print(run(args.before.resolve(), args.rounds, args.output))

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks import engine_report as R
-from benchmarks import report
+from benchmarks import report, timing
 from benchmarks.engine_mujoco import SCENES as MUJOCO_SCENES
 from benchmarks.engine_mujoco import MujocoArm, import_mujoco
 from benchmarks.engine_scenes import (
@@ -29,34 +29,14 @@ from benchmarks.engine_scenes import (
     model_cases,
     stepper,
 )
-from benchmarks.timing import (
-    VERSIONED_PACKAGES,
-    Progress,
-    TimingPlan,
-    arguments,
-    checkpoint,
-    finish,
-    load_text,
-    machine_info,
-    seconds,
-    time_interleaved,
-)
+from benchmarks.timing import Progress, TimingPlan
 from mdi_envs.mechanics.compiled import compile_equations
 from mdi_envs.stepping import MoreauJeanStepper, StepShortcuts
 
 
 @dataclass(frozen=True)
 class ShortcutCase:
-    """One shortcut measurement: a scene timed with the shortcut on and off.
-
-    Attributes:
-        shortcut: the ``StepShortcuts`` field, or ``"no_solve"`` (no switch exists: a free
-            step is timed against the same model's step with a closed contact / engaged brake).
-        model: model label. scene: the scene timed with the shortcut on (the free scene for
-            ``no_solve``).
-        off: the ``StepShortcuts`` of the "off" run (for ``no_solve``: the name of the scene
-            with the solve).
-    """
+    """One shortcut measurement: a scene timed with the shortcut on and off."""
 
     shortcut: str
     model: str
@@ -64,46 +44,26 @@ class ShortcutCase:
     off: StepShortcuts | str
 
 
-SKIP_ROWS_OFF = StepShortcuts(skip_frictionless_rows=False)
-REUSE_MASS_OFF = StepShortcuts(reuse_constant_mass=False)
-DIRECT_SOLVE_OFF = StepShortcuts(direct_solve_max_size=0)
-
-SHORTCUT_CASES = (
-    ShortcutCase("skip_frictionless_rows", "ball", "resting", SKIP_ROWS_OFF),
-    ShortcutCase("skip_frictionless_rows", "ball", "bouncing", SKIP_ROWS_OFF),
-    ShortcutCase("reuse_constant_mass", "ball", "resting", REUSE_MASS_OFF),
-    ShortcutCase("reuse_constant_mass", "ball", "in flight", REUSE_MASS_OFF),
-    ShortcutCase("reuse_constant_mass", "block", "sticking", REUSE_MASS_OFF),
-    ShortcutCase("reuse_constant_mass", "block", "sliding", REUSE_MASS_OFF),
-    ShortcutCase("reuse_constant_mass", "diff_drive", "rolling", REUSE_MASS_OFF),
-    ShortcutCase("reuse_constant_mass", "diff_drive", "slipping", REUSE_MASS_OFF),
-    ShortcutCase("direct_solve_max_size", "ball", "resting", DIRECT_SOLVE_OFF),
-    ShortcutCase("direct_solve_max_size", "block", "sticking", DIRECT_SOLVE_OFF),
-    ShortcutCase("direct_solve_max_size", "block", "sliding", DIRECT_SOLVE_OFF),
-    ShortcutCase("direct_solve_max_size", "manipulator", "tresca", DIRECT_SOLVE_OFF),
+OFF = {"skip_frictionless_rows": StepShortcuts(skip_frictionless_rows=False),
+       "reuse_constant_mass": StepShortcuts(reuse_constant_mass=False),
+       "direct_solve_max_size": StepShortcuts(direct_solve_max_size=0)}
+SHORTCUT_CASES = tuple(ShortcutCase(name, model, scene, OFF[name]) for name, model, scene in (
+    ("skip_frictionless_rows", "ball", "resting"), ("skip_frictionless_rows", "ball", "bouncing"),
+    ("reuse_constant_mass", "ball", "resting"), ("reuse_constant_mass", "ball", "in flight"),
+    ("reuse_constant_mass", "block", "sticking"), ("reuse_constant_mass", "block", "sliding"),
+    ("reuse_constant_mass", "diff_drive", "rolling"),
+    ("reuse_constant_mass", "diff_drive", "slipping"),
+    ("direct_solve_max_size", "ball", "resting"), ("direct_solve_max_size", "block", "sticking"),
+    ("direct_solve_max_size", "block", "sliding"),
+    ("direct_solve_max_size", "manipulator", "tresca"))) + (
     ShortcutCase("no_solve", "ball", "in flight", "resting"),
-    ShortcutCase("no_solve", "manipulator", "released", "engaged"),
-)
-"""The full run's shortcut measurements (cases of absent models are dropped)."""
+    ShortcutCase("no_solve", "manipulator", "released", "engaged"))
+"""Each exact shortcut off on a scene; ``no_solve``: a free scene against one that solves."""
 
 
 @dataclass(frozen=True)
 class EngineConfig:
-    """Models, grid and timing budgets of one run.
-
-    Attributes:
-        models: model labels (see ``engine_scenes.model_cases``).
-        copies: the N of the batched study.
-        call_s: shortest duration of one batched call (substeps are sized to reach it).
-        single_plan: timing plan of the single-step calls (interleaved, all at once).
-        batch_plan: timing plan per N of the batched study and of the per-scene timings.
-        shortcut_plan: timing plan per on/off pair of the shortcut study.
-        scene_copies: N of the per-scene in-kernel timings, the shortcut and substeps studies.
-        shortcut_cases: which shortcut measurements to run.
-        scene_min_substeps: least substeps per call in the per-scene and shortcut studies.
-        substep_grid: substeps per call of the substeps study (empty: skip it).
-        substep_plan: timing plan of the substeps study.
-    """
+    """Models, grid and timing budgets of one run."""
 
     models: tuple[str, ...]
     copies: tuple[int, ...]
@@ -120,29 +80,19 @@ class EngineConfig:
 
 
 FULL = EngineConfig(
-    models=("ball", "block", "manipulator", "diff_drive"),
-    copies=(1, 4, 16, 64, 256, 1024, 4096),
-    call_s=0.01,
-    single_plan=TimingPlan(budget_s=0.2, min_rounds=9, max_rounds=150, min_batch_s=2e-3),
+    models=("ball", "block", "manipulator", "diff_drive"), copies=(1, 4, 16, 64, 256, 1024, 4096),
+    call_s=0.01, single_plan=TimingPlan(budget_s=0.2, min_rounds=9, max_rounds=150,
+                                        min_batch_s=2e-3),
     batch_plan=TimingPlan(budget_s=0.3, min_rounds=9, max_rounds=31),
-    shortcut_plan=TimingPlan(budget_s=0.6, min_rounds=15, max_rounds=61),
-    scene_copies=256,
-    shortcut_cases=SHORTCUT_CASES,
-    substep_grid=(1, 10, 100),
-)
+    shortcut_plan=TimingPlan(budget_s=0.6, min_rounds=15, max_rounds=61), scene_copies=256,
+    shortcut_cases=SHORTCUT_CASES, substep_grid=(1, 10, 100))
 QUICK = EngineConfig(
-    models=("manipulator",),
-    copies=(1, 64, 4096),
-    call_s=0.002,
+    models=("manipulator",), copies=(1, 64, 4096), call_s=0.002,
     single_plan=TimingPlan(budget_s=0.01, min_rounds=3, max_rounds=10, min_batch_s=5e-4),
     batch_plan=TimingPlan(budget_s=0.01, min_rounds=3, max_rounds=5),
-    shortcut_plan=TimingPlan(budget_s=0.01, min_rounds=3, max_rounds=5),
-    scene_copies=64,
-    shortcut_cases=(ShortcutCase("no_solve", "manipulator", "released", "engaged"),),
-)
-
+    shortcut_plan=TimingPlan(budget_s=0.01, min_rounds=3, max_rounds=5), scene_copies=64,
+    shortcut_cases=SHORTCUT_CASES[-1:])
 TARGETS_US = {"manipulator_batched": 0.1, "manipulator_python": 1.0, "diff_drive": 2.0}
-"""The speed targets [µs]."""
 
 
 def _first_batch(st: MoreauJeanStepper, case: ModelCase) -> None:
@@ -152,18 +102,14 @@ def _first_batch(st: MoreauJeanStepper, case: ModelCase) -> None:
 
 def compile_steppers(cases: list[ModelCase], log: Progress
                      ) -> tuple[dict[str, MoreauJeanStepper], list[dict]]:  # fmt: skip
-    """Build each default stepper and time its first ``step`` and ``step_batch`` calls.
-
-    Returns:
-        (label -> stepper, one compile record per stepper).
-    """
+    """Build each default stepper and time its first ``step`` and ``step_batch`` calls."""
     steppers, records = {}, []
     for case in cases:
         log(f"compiling {case.label} (first step, then first step_batch) ...")
         st = steppers[case.label] = stepper(case)
         arrays = case.scenes[0].arrays()
-        step_s = seconds(lambda st=st, arrays=arrays: st.step(*arrays))
-        batch_s = seconds(lambda st=st, case=case: _first_batch(st, case))
+        step_s = timing.seconds(lambda st=st, arrays=arrays: st.step(*arrays))
+        batch_s = timing.seconds(lambda st=st, case=case: _first_batch(st, case))
         records.append({"stepper": f"{case.label} (default shortcuts)", "step_s": step_s,
                         "step_batch_s": batch_s})
         log(f"  {case.label}: first step {step_s:.1f} s, first step_batch {batch_s:.1f} s")
@@ -175,15 +121,7 @@ IN_PLACE_STEPS_PER_CALL = 200
 
 
 def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
-    """``InPlaceStepper.step`` at the scene: the public fastest single step from Python.
-
-    One compiled call on a flat buffer. The returned callable makes ``IN_PLACE_STEPS_PER_CALL``
-    calls of ``step()`` in a Python ``for`` loop, as a user's rollout would, and then puts the
-    state back at the scene's (the state advances in place); its time is divided by that count,
-    so each step carries its share of the loop and of the reset. The in-place kernel is
-    compiled here, by one step: a compilation inside the timer's warm-up call would make it
-    time single calls.
-    """
+    """``InPlaceStepper.step()`` in a Python loop (``IN_PLACE_STEPS_PER_CALL``), then a reset."""
     q, u, tau, brake = arrays
     stepper = st.in_place(q, u)
     stepper.tau[:] = tau
@@ -220,21 +158,13 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
         for scene, call in arm.single_step_calls().items():
             calls[f"mujoco|{scene}|mj_step"] = call
     log(f"single step: {len(calls)} callables, interleaved ...")
-    timed = time_interleaved(calls, config.single_plan)
+    timed = timing.time_interleaved(calls, config.single_plan)
     rows = []
     for key, value in timed.items():
         model, scene, entry = key.split("|")
         steps = IN_PLACE_STEPS_PER_CALL if entry == "in_place" else 1
         rows.append({"model": model, "scene": scene, "entry": entry,
                      **value.summary(operations_per_call=steps)})
-    for case in cases:
-        cells = [f"{r['scene']} {report.format_us_fine(r['median_s'])}" for r in rows
-                 if r["model"] == case.label and r["entry"] == "step"]
-        log(f"  {case.label} step() µs: " + ", ".join(cells))
-    if arm is not None:
-        cells = [f"{r['scene']} {report.format_us_fine(r['median_s'])}" for r in rows
-                 if r["model"] == "mujoco"]
-        log("  MuJoCo mj_step µs: " + ", ".join(cells))
     return rows
 
 
@@ -261,29 +191,18 @@ def _mujoco_entry(arm: MujocoArm, num_copies: int, target_s: float,
     return arm.rollout_call(num_copies, steps, scenes), steps
 
 
-def _per_copy_step(timed_summary: dict[str, Any], num_copies: int, substeps: int
-                   ) -> dict[str, Any]:
-    """A ``Timed.summary`` of one call, scaled to one copy-step."""
+def _per_copy_step(call: dict[str, Any], num_copies: int, substeps: int) -> dict[str, Any]:
+    """A ``Timed.summary`` of one call, and its times scaled to one copy-step."""
     scale = 1.0 / (num_copies * substeps)
-    return {
-        "copies": num_copies,
-        "substeps": substeps,
-        "call": timed_summary,
-        "per_copy_step_s": timed_summary["median_s"] * scale,
-        "per_copy_step_q1_s": timed_summary["q1_s"] * scale,
-        "per_copy_step_q3_s": timed_summary["q3_s"] * scale,
-        "per_copy_step_min_s": timed_summary["min_s"] * scale,
-    }
+    return {"copies": num_copies, "substeps": substeps, "call": call,
+            **{f"per_copy_step{k}_s": call[f"{stat}_s"] * scale
+               for k, stat in (("", "median"), ("_q1", "q1"), ("_q3", "q3"), ("_min", "min"))}}
 
 
 def _per_copy_rows(calls: dict[str, Callable[[], Any]], substeps: dict[str, int], n: int,
                    plan: TimingPlan, fields: tuple[str, ...]) -> list[dict[str, Any]]:
-    """Time ``calls`` interleaved; one row per call with its per-copy-step timing.
-
-    A row holds ``fields`` from the call's key (``"a|b"``) and ``_per_copy_step`` of its
-    ``n`` copies and ``substeps[key]`` substeps.
-    """
-    timed = time_interleaved(calls, plan)
+    """Time ``calls`` interleaved; one row per call with its per-copy-step timing."""
+    timed = timing.time_interleaved(calls, plan)
     return [{**dict(zip(fields, key.split("|"), strict=False)),
              **_per_copy_step(value.summary(), n, substeps[key])} for key, value in timed.items()]
 
@@ -306,10 +225,7 @@ def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
             key = f"mujoco|{scene}"
             calls[key], substeps[key] = _mujoco_entry(arm, n, config.call_s, (scene,))
     log(f"in-kernel per scene (N = {n}): {len(calls)} callables, interleaved ...")
-    rows = _per_copy_rows(calls, substeps, n, config.batch_plan, ("model", "scene"))
-    log("  " + ", ".join(f"{r['model']}/{r['scene']} {report.format_us_fine(r['per_copy_step_s'])}"
-                         for r in rows))
-    return rows
+    return _per_copy_rows(calls, substeps, n, config.batch_plan, ("model", "scene"))
 
 
 def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
@@ -328,29 +244,22 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
         measured = _per_copy_rows(calls, substeps, n, config.batch_plan, ("model",))
         rows += measured
         log(f"batched N = {n}: " + ", ".join(
-            f"{r['model']} {report.format_us_fine(r['per_copy_step_s'])} µs (x{r['substeps']})"
-            for r in measured) + f"; load {load_text()}")
+            f"{r['model']} {report.format_us(r['per_copy_step_s'])} µs (x{r['substeps']})"
+            for r in measured) + f"; load {timing.load_text()}")
     return rows
 
 
 def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
                    config: EngineConfig, log: Progress) -> list[dict[str, Any]]:
-    """µs per copy-step of each model's mix at N = ``scene_copies`` for a few substeps per call.
-
-    Shows what a call costs beyond its steps.
-    """
+    """µs per copy-step of each model's mix at N = ``scene_copies`` for a few substeps per call."""
     if not config.substep_grid:
         return []
     n = config.scene_copies
     calls = {f"{case.label}|{k}": BatchedCall(steppers[case.label], batch_arrays(case, n), k)
              for case in cases for k in config.substep_grid}
     log(f"substeps per call (N = {n}): {len(calls)} callables, interleaved ...")
-    rows = _per_copy_rows(calls, {key: call.num_substeps for key, call in calls.items()}, n,
+    return _per_copy_rows(calls, {key: call.num_substeps for key, call in calls.items()}, n,
                           config.substep_plan, ("model",))
-    log("  " + ", ".join(f"{r['model']} x{r['substeps']} "
-                         f"{report.format_us_fine(r['per_copy_step_s'])}"
-                         for r in rows))
-    return rows
 
 
 def _state_difference(first: BatchedCall, second: BatchedCall) -> float:
@@ -380,7 +289,7 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
             if key not in variants:
                 log(f"compiling {case.label} with {R.shortcuts_text(sc.off)} ...")
                 st = stepper(case, sc.off)
-                batch_s = seconds(lambda st=st, case=case: _first_batch(st, case))
+                batch_s = timing.seconds(lambda st=st, case=case: _first_batch(st, case))
                 compile_records.append({"stepper": f"{case.label} ({R.shortcuts_text(sc.off)})",
                                         "step_s": None, "step_batch_s": batch_s})
                 log(f"  first step_batch {batch_s:.1f} s")
@@ -394,26 +303,18 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
                                  config.scene_min_substeps)
             difference = None
             off_scene = sc.off
-        timed = time_interleaved({"on": on, "off": off}, config.shortcut_plan)
-        row = {
-            "shortcut": sc.shortcut,
-            "model": sc.model,
-            "scene": sc.scene,
-            "off_scene": off_scene,
-            "off_shortcuts": sc.off._asdict() if isinstance(sc.off, StepShortcuts) else None,
-            "on": _per_copy_step(timed["on"].summary(), n, on.num_substeps),
-            "off": _per_copy_step(timed["off"].summary(), n, off.num_substeps),
-            "max_state_difference": difference,
-        }
+        timed = timing.time_interleaved({"on": on, "off": off}, config.shortcut_plan)
+        row = {"shortcut": sc.shortcut, "model": sc.model, "scene": sc.scene,
+               "off_scene": off_scene,
+               "off_shortcuts": sc.off._asdict() if isinstance(sc.off, StepShortcuts) else None,
+               "on": _per_copy_step(timed["on"].summary(), n, on.num_substeps),
+               "off": _per_copy_step(timed["off"].summary(), n, off.num_substeps),
+               "max_state_difference": difference}
         row["speedup"] = row["off"]["per_copy_step_s"] / row["on"]["per_copy_step_s"]
         row["speedup_fastest_rounds"] = (row["off"]["per_copy_step_min_s"]
                                          / row["on"]["per_copy_step_min_s"])
         rows.append(row)
-        log(f"shortcut {sc.shortcut} on {sc.model}/{sc.scene}: on "
-            f"{report.format_us_fine(row['on']['per_copy_step_s'])} µs, off "
-            f"{report.format_us_fine(row['off']['per_copy_step_s'])} µs"
-            f"{'' if off_scene == sc.scene else f' ({off_scene})'}, speedup "
-            f"{row['speedup']:.2f}")
+        log(f"shortcut {sc.shortcut} on {sc.model}/{sc.scene}: speedup {row['speedup']:.2f}")
     return rows
 
 
@@ -469,7 +370,7 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
         key = "manipulator_batched" if model == "manipulator" else model
         targets.append(report.target_row(
             f"{title}, batched, µs per copy-step (mix, largest N)", "≤", TARGETS_US[key], "µs",
-            us(value), f"N = {copies}; best over N {report.format_us_fine(best)} µs"
+            us(value), f"N = {copies}; best over N {report.format_us(best)} µs"
             if best is not None else ""))
         key = "manipulator_python" if model == "manipulator" else model
         targets.append(report.target_row(
@@ -483,23 +384,20 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
     log = Progress()
     output.mkdir(parents=True, exist_ok=True)
     record: dict[str, Any] = {
-        "machine": machine_info((*VERSIONED_PACKAGES, "mujoco")),
+        "machine": timing.machine_info((*timing.VERSIONED_PACKAGES, "mujoco")),
         "config": {"quick": quick, "time_step": TIME_STEP,
                    **{k: v for k, v in asdict(config).items() if k != "shortcut_cases"}},
-        "notes": [],
-        "load_log": [],
-    }
-    notes = record["notes"]
+        "notes": [], "load_log": []}
 
     def section(name: str) -> None:
-        checkpoint(record, name, log.elapsed)
+        timing.checkpoint(record, name, log.elapsed)
 
-    log(f"engine benchmark ({'quick' if quick else 'full'}) -> {output}; load {load_text()}")
+    log(f"engine benchmark ({'quick' if quick else 'full'}) -> {output}; load {timing.load_text()}")
     cases = model_cases(config.models)
     mujoco, mujoco_note = import_mujoco()
     arm = MujocoArm(mujoco) if mujoco is not None else None
     if mujoco_note:
-        notes.append(mujoco_note)
+        record["notes"].append(mujoco_note)
         log(mujoco_note)
     section("compile")
     steppers, compile_records = compile_steppers(cases, log)
@@ -526,20 +424,13 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
     if arm is not None:
         arm.close()
     section("end")
-    record.update({
-        "compile": compile_records,
-        "single_step": single,
-        "per_scene": scenes,
-        "batched": batched,
-        "substeps": substeps,
-        "shortcuts": shortcuts,
-        "brake_stop": brake,
-        "targets": evaluate_targets(single, batched),
-    })
+    record.update({"compile": compile_records, "single_step": single, "per_scene": scenes,
+                   "batched": batched, "substeps": substeps, "shortcuts": shortcuts,
+                   "brake_stop": brake, "targets": evaluate_targets(single, batched)})
     R.plot_batched(batched, substeps, TARGETS_US, output / "engine_batched.png")
     R.plot_single_step(single, scenes, TARGETS_US, output / "engine_single_step.png")
     R.plot_shortcuts(shortcuts, output / "engine_shortcuts.png")
-    finish(record, log.elapsed, speed=True)
+    timing.finish(record, log.elapsed, speed=True)
     report.write_json(record, output / "engine.json")
     log(f"done in {log.elapsed:.0f} s; wrote engine.json and 3 plots to {output}")
     return R.markdown_report(record)
@@ -547,11 +438,8 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    args = arguments(__doc__, argv, "manipulator and MuJoCo only, small grid and budgets (~20 s)",
-                     "results/bench",
-                     extra=lambda parser: parser.add_argument(
-                         "--models", default=None, help="comma-separated models instead of the "
-                         f"run's own (of {', '.join(FULL.models)})"))
+    args = timing.arguments(__doc__, argv, ("--models", {"help": "comma-separated, of "
+                                                         + ", ".join(FULL.models)}))
     config = QUICK if args.quick else FULL
     if args.models:
         models = tuple(args.models.split(","))

@@ -8,10 +8,13 @@ contact's ``solref`` damping ratio, by the damped-oscillator formula or calibrat
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.optimize import brentq
 
 from benchmarks.engine_scenes import (
     MANIPULATOR_Q,
@@ -20,6 +23,7 @@ from benchmarks.engine_scenes import (
     TIME_STEP,
     TRESCA_BOUND,
 )
+from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
 
 MJCF = """
 <mujoco model="blockable_manipulator">
@@ -56,11 +60,7 @@ def import_mujoco() -> tuple[Any, str | None]:
 
 @dataclass
 class MujocoArm:
-    """The MJCF arm, its Python single steps, batched rollouts and the brake-stop test.
-
-    Args:
-        mujoco: the imported module.
-    """
+    """The MJCF arm, its Python single steps, batched rollouts and the brake-stop test."""
 
     mujoco: Any
 
@@ -108,13 +108,7 @@ class MujocoArm:
 
     def rollout_call(self, num_copies: int, num_steps: int,
                      scenes: tuple[str, ...] = SCENES) -> Any:
-        """A zero-argument single-thread ``rollout`` of N copies by ``num_steps`` steps.
-
-        Outputs are preallocated and ``skip_checks=True``. Copy i runs scene
-        ``scenes[i % len(scenes)]`` (default: the manipulator's mix); the brake state is the
-        ``eq_active`` part of the control (``mjSTATE_CTRL | mjSTATE_EQ_ACTIVE``), the Tresca
-        copies use the frictionloss model. Every call starts from the same initial states.
-        """
+        """A zero-argument single-thread ``rollout`` of N copies by ``num_steps`` steps."""
         from mujoco import rollout
 
         if self._rollout is None:
@@ -147,18 +141,7 @@ class MujocoArm:
 
     def brake_stop(self, solref: tuple[float, float] | None, max_steps: int = 10_000
                    ) -> dict[str, Any]:
-        """Steps until |q2'| < 1 % of 1 rad/s after the brake engages at q2' = 1 rad/s.
-
-        Link 1 at rest, no torque; the brake locks joint 2 at its current angle 0.
-
-        Args:
-            solref: the equality's (timeconst, dampratio), or None for MuJoCo's default.
-            max_steps: give up after this many steps.
-
-        Returns:
-            steps (None if not reached), the |q2'| trace up to then (at most 200 entries), the
-            relative angle when reached and its largest magnitude on the way.
-        """
+        """Steps until |q2'| < 1 % of 1 rad/s after the brake engages at q2' = 1 rad/s."""
         mj = self.mujoco
         model = self._model(frictionloss=0.0, lock=0.0)
         if solref is not None:
@@ -194,4 +177,168 @@ class MujocoArm:
             self._rollout = None
 
 
-__all__ = ["MJCF", "SCENES", "MujocoArm", "import_mujoco"]
+BALL_MJCF = """
+<mujoco model="bouncing_ball">
+  <option timestep="{dt}" gravity="0 0 {gravity}"/>
+  <default><geom condim="1" solref="{timeconst} {dampratio}"/></default>
+  <worldbody>
+    <geom name="ground" type="plane" size="1 1 0.1"/>
+    <body name="ball">
+      <joint name="height" type="slide" axis="0 0 1"/>
+      <geom name="ball" type="sphere" size="{radius}" mass="{mass}"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+BALL_TIMECONST = 0.02  # [s] the contact's solref time constant (MuJoCo's default)
+
+CALIBRATION_DROP = 0.5  # [m] drop of the calibration run
+
+CALIBRATION_XTOL = 1e-7  # on the calibrated dampratio
+
+
+def formula_dampratio(restitution: float) -> float:
+    """Damping ratio -ln(eps) / sqrt(pi^2 + ln(eps)^2) of a bounce with restitution eps."""
+    log_eps = math.log(restitution)
+    return -log_eps / math.sqrt(math.pi**2 + log_eps**2)
+
+
+@dataclass
+class MujocoBall:
+    """The MuJoCo ball at time step dt [s] and contact solref (timeconst [s], dampratio)."""
+
+    mujoco: Any
+    parameters: BouncingBallParameters
+    time_step: float
+    dampratio: float
+    timeconst: float = BALL_TIMECONST
+
+    def __post_init__(self) -> None:
+        p = self.parameters
+        xml = BALL_MJCF.format(dt=self.time_step, gravity=-p.gravity, timeconst=self.timeconst,
+                               dampratio=self.dampratio, radius=p.radius, mass=p.mass)
+        self.model = self.mujoco.MjModel.from_xml_string(xml)
+        self.data = self.mujoco.MjData(self.model)
+        self._spec = self.mujoco.mjtState.mjSTATE_FULLPHYSICS.value
+
+    @property
+    def contact_settings(self) -> dict[str, list[float]]:
+        """The ball geom's solref and solimp as compiled (JSON-ready)."""
+        return {"solref": [float(x) for x in self.model.geom_solref[1]],
+                "solimp": [float(x) for x in self.model.geom_solimp[1]]}
+
+    def _reset(self, gap: float) -> None:
+        self.mujoco.mj_resetData(self.model, self.data)
+        self.data.qpos[0] = self.parameters.radius + gap
+
+    def run(self, gap: float, num_steps: int) -> tuple[float, float]:
+        """Final (height [m], velocity [m/s]) of a drop from rest at ``gap``, one mj_step call."""
+        self._reset(gap)
+        self.mujoco.mj_step(self.model, self.data, nstep=num_steps)
+        return float(self.data.qpos[0]), float(self.data.qvel[0])
+
+    def trajectories(self, gaps: Sequence[float] | np.ndarray, num_steps: int
+                     ) -> tuple[np.ndarray, np.ndarray]:
+        """Heights y and velocities v (D, K + 1) of drops from rest at D gaps (one rollout)."""
+        from mujoco import rollout
+
+        mj = self.mujoco
+        size = mj.mj_stateSize(self.model, self._spec)
+        initial = np.empty((len(gaps), size))
+        for i, gap in enumerate(gaps):
+            self._reset(gap)
+            mj.mj_getState(self.model, self.data, initial[i], self._spec)
+        state, _ = rollout.rollout(self.model, mj.MjData(self.model), initial_state=initial,
+                                   nstep=num_steps)
+        y = np.concatenate([initial[:, 1:2], state[:, :, 1]], axis=1)
+        v = np.concatenate([initial[:, 2:3], state[:, :, 2]], axis=1)
+        return y, v
+
+    def effective_restitution(self, drop: float = CALIBRATION_DROP) -> float:
+        """sqrt(first rebound apex / drop) of a drop from gap ``drop`` [m]; NaN if none."""
+        g = self.parameters.gravity
+        t_apex = math.sqrt(2.0 * drop / g) * 2.0  # rebound apex at t1 (1 + eps) < 2 t1
+        y, v = self.trajectories([drop], int(math.ceil((t_apex + 0.05) / self.time_step)))
+        rising = np.nonzero(v[0] > 0.0)[0]
+        if rising.size == 0 or not np.isfinite(y).all():
+            return float("nan")
+        apex = float(y[0, rising[0]:].max()) - self.parameters.radius
+        return math.sqrt(apex / drop) if apex > 0.0 else float("nan")
+
+
+def calibrate_dampratio(mujoco: Any, parameters: BouncingBallParameters, time_step: float,
+                        timeconst: float = BALL_TIMECONST) -> tuple[float | None, str]:
+    """(dampratio whose calibration drop rebounds with eps (Brent), or None; a note)."""
+    target = parameters.restitution
+    evaluations = 0
+
+    def mismatch(dampratio: float) -> float:
+        nonlocal evaluations
+        evaluations += 1
+        ball = MujocoBall(mujoco, parameters, time_step, dampratio, timeconst)
+        value = ball.effective_restitution()
+        return (value if np.isfinite(value) else 2.0) - target  # diverged: far too bouncy
+
+    start = formula_dampratio(target)
+    low, high = 0.25 * start, 4.0 * start
+    try:
+        f_low, f_high = mismatch(low), mismatch(high)
+        if f_low * f_high > 0.0:
+            return None, f"no sign change of eps_eff - eps on [{low:.3g}, {high:.3g}]"
+        value = brentq(mismatch, low, high, xtol=CALIBRATION_XTOL)
+    except (RuntimeError, ValueError) as error:
+        return None, f"calibration failed: {error}"
+    return float(value), f"{evaluations} calibration drops"
+
+
+@dataclass
+class MujocoArmRun:
+    """The MuJoCo arm at dt [s] driven by phases; brake ``solref`` None: MuJoCo's default."""
+
+    mujoco: Any
+    time_step: float
+    solref: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        xml = MJCF.format(dt=self.time_step, rod=1.0 / 12.0, frictionloss=0.0, lock=0.0)
+        self.model = self.mujoco.MjModel.from_xml_string(xml)
+        if self.solref is not None:
+            self.model.eq_solref[0] = self.solref
+        self.data = self.mujoco.MjData(self.model)
+
+    @property
+    def brake_settings(self) -> dict[str, list[float]]:
+        """The brake equality's solref and solimp (JSON-ready)."""
+        return {"solref": [float(x) for x in self.model.eq_solref[0]],
+                "solimp": [float(x) for x in self.model.eq_solimp[0]]}
+
+    def state(self) -> np.ndarray:
+        """(alpha, beta, alpha', beta') in our coordinates [rad, rad/s]."""
+        q, u = self.data.qpos, self.data.qvel
+        return np.array([q[0], q[0] + q[1], u[0], u[0] + u[1]])
+
+    def simulate(self, phases: Sequence[tuple[int, float, bool]], stride: int | None = None
+                 ) -> tuple[np.ndarray, np.ndarray | None]:
+        """From rest through (steps, torque [N m], brake engaged) phases, one mj_step each."""
+        mj, model, data = self.mujoco, self.model, self.data
+        mj.mj_resetData(model, data)
+        samples = [self.state()] if stride is not None else None
+        engaged_before = False
+        for steps, torque, engaged in phases:
+            data.ctrl[0] = torque
+            if engaged and not engaged_before:
+                model.eq_data[0, 0] = data.qpos[1]  # lock the relative angle where it is
+            data.eq_active[0] = 1 if engaged else 0
+            engaged_before = engaged
+            if samples is None or stride is None:
+                mj.mj_step(model, data, nstep=steps)
+                continue
+            for _ in range(steps // stride):
+                mj.mj_step(model, data, nstep=stride)
+                samples.append(self.state())
+        return self.state(), None if samples is None else np.array(samples)
+
+
+__all__ = ["MJCF", "SCENES", "MujocoArm", "MujocoArmRun", "MujocoBall", "calibrate_dampratio",
+           "formula_dampratio", "import_mujoco"]

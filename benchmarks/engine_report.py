@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import format_us_fine, plt, save_figure, summary
+from benchmarks.report import bars, format_us, log_lines, plt, save_figure, summary
 
 MODEL_TITLES = {
     "ball": "bouncing ball",
@@ -69,80 +69,41 @@ def brake_rows(brake: Mapping[str, Any] | None) -> tuple[list[dict[str, Any]], l
 
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],
                  targets_us: Mapping[str, float], path: Path) -> None:
-    """µs per copy-step vs N (log-log), one line per model and MuJoCo, band = quartiles.
-
-    A second panel (if measured) shows it against the substeps per call.
-    """
+    """µs per copy-step against N (and against substeps per call), one line per model."""
     panels = 2 if substeps else 1
     fig, axes = plt.subplots(1, panels, figsize=(7.5 + 4.5 * (panels - 1), 4.8), sharey=True,
                              gridspec_kw={"width_ratios": [5, 3][:panels]})
     axes = list(np.atleast_1d(axes))
-    _batched_panel(axes[0], batched, "copies", "copies N per step_batch call")
+    for ax, rows, x in zip(axes, (batched, substeps), ("copies", "substeps"), strict=False):
+        log_lines(ax, rows, x, "per_copy_step_s", "model", ("per_copy_step_q1_s",
+                  "per_copy_step_q3_s"), 1e6, lambda m: MODEL_TITLES.get(m, m),
+                  lambda m: m == "mujoco")
+        ax.set_xlabel(f"{x} per step_batch call")
+    for model, key, color in (("manipulator", "manipulator_batched", "tab:green"),
+                              ("diff_drive", "diff_drive", "tab:red")):
+        if any(r["model"] == model for r in batched):
+            axes[0].axhline(targets_us[key], color=color, lw=0.9, ls=":",
+                            label=f"{model} target {targets_us[key]:g} µs")
     axes[0].set_title("Batched stepping (single thread), per copy-step")
-    models = {r["model"] for r in batched}
-    axes[0].axhline(targets_us["manipulator_batched"], color="tab:green", lw=0.9, ls=":",
-                    label=f"manipulator target {targets_us['manipulator_batched']:g} µs")
-    if "diff_drive" in models:
-        axes[0].axhline(targets_us["diff_drive"], color="tab:red", lw=0.9, ls=":",
-                        label=f"diff-drive target {targets_us['diff_drive']:g} µs")
-    axes[0].set_ylabel("µs per copy-step")
+    axes[0].set_ylabel("µs per copy-step (band: quartiles)")
     axes[0].legend(fontsize=7, loc="best")
-    if substeps:
-        _batched_panel(axes[1], substeps, "substeps", "substeps per call")
-        axes[1].set_title(f"N = {substeps[0]['copies']}", fontsize=10)
     save_figure(fig, path)
-
-
-def _batched_panel(ax: Any, rows_in: Sequence[dict[str, Any]], x_key: str, xlabel: str
-                   ) -> None:
-    """One log-log panel of µs per copy-step against ``x_key``, one line per model."""
-    models = list(dict.fromkeys(r["model"] for r in rows_in))
-    xs = sorted({r[x_key] for r in rows_in})
-    for model in models:
-        rows = sorted((r for r in rows_in if r["model"] == model), key=lambda r: r[x_key])
-        x = [r[x_key] for r in rows]
-        y = [r["per_copy_step_s"] * 1e6 for r in rows]
-        style = "k--" if model == "mujoco" else "-"
-        (line,) = ax.plot(x, y, style, marker="o", ms=4, label=MODEL_TITLES.get(model, model))
-        ax.fill_between(x, [r["per_copy_step_q1_s"] * 1e6 for r in rows],
-                        [r["per_copy_step_q3_s"] * 1e6 for r in rows],
-                        color=line.get_color(), alpha=0.15)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xticks(xs, [str(x) for x in xs])
-    ax.minorticks_off()
-    ax.set_xlabel(xlabel)
-    ax.grid(True, which="both", alpha=0.3)
 
 
 def plot_single_step(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str, Any]],
                      targets_us: Mapping[str, float], path: Path) -> None:
-    """Horizontal bars per (model, scene): Python step, in-place step, in-kernel step."""
-    index = {(r["model"], r["scene"], r["entry"]): r["median_s"] for r in single}
-    kernel = {(r["model"], r["scene"]): r["per_copy_step_s"] for r in scenes}
+    """Horizontal bars per (model, scene): Python step, in-place step, in-kernel step [µs]."""
+    index = {(r["model"], r["scene"], r["entry"]): r["median_s"] * 1e6 for r in single}
+    index.update({(r["model"], r["scene"], "kernel"): r["per_copy_step_s"] * 1e6 for r in scenes})
     keys = list(dict.fromkeys((r["model"], r["scene"]) for r in single))
-    series = [
-        ("one step from Python: step() / mj_step", lambda m, s: index.get(
-            (m, s, "mj_step" if m == "mujoco" else "step"))),
-        ("InPlaceStepper.step() from Python", lambda m, s: index.get((m, s, "in_place"))),
-        ("in-kernel (batched)", lambda m, s: kernel.get((m, s))),
-    ]
-    y = np.arange(len(keys))
     fig, ax = plt.subplots(figsize=(8.5, 0.42 * len(keys) + 1.6))
-    height = 0.27
-    for i, (label, get) in enumerate(series):
-        values = [get(m, s) for m, s in keys]
-        widths = [np.nan if v is None else v * 1e6 for v in values]
-        ax.barh(y + (i - 1) * height, widths, height, label=label)
     ax.axvline(targets_us["manipulator_python"], color="tab:green", lw=0.9, ls=":",
                label=f"manipulator target (Python) {targets_us['manipulator_python']:g} µs")
-    ax.set_xscale("log")
-    ax.set_yticks(y, [f"{'MuJoCo' if m == 'mujoco' else m} / {s}" for m, s in keys],
-                  fontsize=8)
-    ax.invert_yaxis()
-    ax.set_xlabel("µs per step")
-    ax.grid(True, axis="x", which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, frameon=False)
+    bars(ax, [f"{m} / {s}" for m, s in keys], {
+        "one step from Python: step() / mj_step": [
+            index.get((m, s, "mj_step" if m == "mujoco" else "step")) for m, s in keys],
+        "InPlaceStepper.step() from Python": [index.get((m, s, "in_place")) for m, s in keys],
+        "in-kernel (batched)": [index.get((m, s, "kernel")) for m, s in keys]}, "µs per step")
     save_figure(fig, path)
 
 
@@ -163,8 +124,8 @@ def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
         ax.plot(fastest, y, "kD", ms=4, label="ratio of fastest rounds")
         for yi, r in zip(y, shortcuts, strict=True):
             ax.text(max(r["speedup"], r["speedup_fastest_rounds"]), yi,
-                    f"  {format_us_fine(r['on']['per_copy_step_s'])} vs "
-                    f"{format_us_fine(r['off']['per_copy_step_s'])} µs", va="center", fontsize=7)
+                    f"  {format_us(r['on']['per_copy_step_s'])} vs "
+                    f"{format_us(r['off']['per_copy_step_s'])} µs", va="center", fontsize=7)
         ax.set_yticks(y, labels, fontsize=8)
         ax.invert_yaxis()
         ax.set_xlim(0.0, 1.25 * max(max(speedups), max(fastest), 1.0))

@@ -33,13 +33,7 @@ MANIPULATOR_U = (0.5, 1.0)
 
 @dataclass(frozen=True)
 class Scene:
-    """One state and input of one model.
-
-    Attributes:
-        name: short label (``"resting"``, ``"engaged"``, ...).
-        description: what the scene is, for the README.
-        q, u: coordinates and velocities. tau: inputs. brake: brake bounds (empty: no brakes).
-    """
+    """One state and input of one model."""
 
     name: str
     description: str
@@ -56,13 +50,7 @@ class Scene:
 
 @dataclass(frozen=True)
 class ModelCase:
-    """A model under test with its scenes.
-
-    Attributes:
-        label: name in tables and plots. model: the ``ModelDefinition`` subclass.
-        scenes: the scenes.
-        mix: names of the scenes the batched mix cycles through (default: all).
-    """
+    """A model under test with its scenes."""
 
     label: str
     model: Any
@@ -136,11 +124,7 @@ def model_cases(names: Sequence[str]) -> list[ModelCase]:
 
 def batch_arrays(case: ModelCase, num_copies: int, scenes: Sequence[Scene] | None = None
                  ) -> tuple[np.ndarray, ...]:
-    """(Q, U, TAU, BRAKE) for ``num_copies`` copies; copy i gets scene i mod len(scenes).
-
-    Args:
-        case: the model. num_copies: N. scenes: default the case's mix.
-    """
+    """(Q, U, TAU, BRAKE) for ``num_copies`` copies; copy i gets scene i mod len(scenes)."""
     chosen = list(scenes or case.mix_scenes)
     picks = [chosen[i % len(chosen)] for i in range(num_copies)]
     model = case.model
@@ -155,13 +139,9 @@ def batch_arrays(case: ModelCase, num_copies: int, scenes: Sequence[Scene] | Non
 
 @dataclass
 class BatchedCall:
-    """One ``step_batch`` call on N copies, restarted from the same states every time.
+    """One ``step_batch`` call on N copies (no input checks), restarted from the same states.
 
-    The state of a copy is (q, u) and, for spatial contacts, the impulses that warm-start its
-    solver: those of one step from (q, u), as a running simulation passing through the state
-    would hold (``step_batch`` reads them from ``out``). Calling it copies the initial states
-    into the working arrays (a few µs at N = 4096, under 0.1 % of a 10 ms call) and advances
-    them by ``num_substeps`` steps, without the input checks (the arrays are the stepper's).
+    Spatial contacts' warm-start impulses start as those of one step from the states.
     """
 
     stepper: MoreauJeanStepper
@@ -191,14 +171,7 @@ class BatchedCall:
 
 def calibrate_substeps(make: Callable[[int], Callable[[], Any]], target_s: float,
                        max_substeps: int = 10**7) -> int:
-    """About the smallest number of substeps for which one call lasts ``target_s``.
-
-    Args:
-        make: ``make(substeps)`` returns a zero-argument call doing that many substeps (only
-            the call is timed, not ``make``).
-        target_s: wanted duration of one call [s].
-        max_substeps: cap.
-    """
+    """About the smallest number of substeps for which one call lasts ``target_s``."""
     substeps = 1
     seconds = 0.0
     for _ in range(40):

@@ -1,4 +1,4 @@
-"""The solver entry points under test, each timed on its bare call and read afterwards."""
+"""The LCP solver entries under test: each timed on its bare call, its outcome read afterwards."""
 
 from __future__ import annotations
 
@@ -13,32 +13,16 @@ from mdi_envs.solvers.lcp import lcp_residual, solve_lcp
 from mdi_envs.solvers.lcp.lemke import LemkeOptions, lemke_solve
 from mdi_envs.solvers.status import SolverStatus
 
-LCP_METHODS = ("lemke", "pgs", "newton_fb", "enumerative")
-"""Methods of ``solve_lcp`` in the work-size study."""
-
-ENUMERATIVE_MAX_N = 10
-"""Largest size the exhaustive method is run at (it examines 2^n index sets)."""
-
-QUANTECON_MAX_ITER = 10_000
-"""Pivot cap for QuantEcon (its default of 10^6 cycles for minutes on lcp_tobenna)."""
-
+LCP_METHODS = ("lemke", "pgs", "newton_fb", "enumerative")  # of solve_lcp, in the size study
+ENUMERATIVE_MAX_N = 10  # largest n of the exhaustive method (2^n index sets)
+QUANTECON_MAX_ITER = 10_000  # QuantEcon's pivot cap (its default 10^6 cycles on lcp_tobenna)
 QUANTECON_STATUS = {0: "0 (solved)", 1: "1 (iteration limit)", 2: "2 (secondary ray)"}
-"""QuantEcon's own status codes, reported in its own words."""
-
 _LEMKE = LemkeOptions()
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """What one solve produced, in a form shared by every entry.
-
-    Attributes:
-        success: the entry's own success flag (ours: status CONVERGED, which includes our
-            residual check; QuantEcon: its ``success``, which checks no residual).
-        status: the entry's status in its own vocabulary.
-        iterations: pivots, sweeps or Newton steps, as the entry counts them.
-        residual: ``||min(z, M z + q)|| / max(||q||, 1)``, recomputed with ``lcp_residual``.
-    """
+    """A solve's own success flag and status, its iterations and the shared residual measure."""
 
     success: bool
     status: str
@@ -48,14 +32,7 @@ class Outcome:
 
 @dataclass(frozen=True)
 class Entry:
-    """A timed callable and the reader of its raw result.
-
-    Attributes:
-        name: short key used in the JSON and tables.
-        label: human-readable description for plots.
-        solve: ``solve(M, q) -> raw result``; the only thing that is timed.
-        read: ``read(raw, M, q) -> Outcome``.
-    """
+    """A timed ``solve(M, q)`` and ``read(raw, M, q) -> Outcome`` of its raw result."""
 
     name: str
     label: str
@@ -65,54 +42,27 @@ class Entry:
 
 def driver_entry(method: str) -> Entry:
     """The public driver ``solve_lcp(M, q, method=method)`` (validation + residual included)."""
-
-    def solve(M: FloatArray, q: FloatArray) -> Any:
-        return solve_lcp(M, q, method=method)
-
-    def read(result: Any, M: FloatArray, q: FloatArray) -> Outcome:
-        return Outcome(
-            result.status is SolverStatus.CONVERGED,
-            result.status.name,
-            int(result.num_iter),
-            float(result.residual),
-        )
-
-    return Entry(method, f"solve_lcp(method={method!r})", solve, read)
-
-
-def _kernel_solve(M: FloatArray, q: FloatArray) -> Any:
-    """Our compiled Lemke entry with the driver's default options."""
-    return lemke_solve(M, q, _LEMKE.max_iter, _LEMKE.pivot_tol, _LEMKE.tie_tol, _LEMKE.tol)
+    return Entry(method, f"solve_lcp(method={method!r})",
+                 lambda M, q: solve_lcp(M, q, method=method),
+                 lambda r, M, q: Outcome(r.status is SolverStatus.CONVERGED, r.status.name,
+                                         int(r.num_iter), float(r.residual)))
 
 
 def _kernel_read(raw: Any, M: FloatArray, q: FloatArray) -> Outcome:
-    """Outcome of ``lemke_solve``: (z, code, pivots); the residual is recomputed here."""
     z, code, pivots = raw
     status = SolverStatus(code)
-    return Outcome(
-        status is SolverStatus.CONVERGED, status.name, int(pivots), lcp_residual(M, q, z)
-    )
+    return Outcome(status is SolverStatus.CONVERGED, status.name, int(pivots),
+                   lcp_residual(M, q, z))
 
 
-def _quantecon_solve(M: FloatArray, q: FloatArray) -> Any:
-    """QuantEcon's compiled Lemke with the pivot cap (all other options at its defaults)."""
-    return lcp_lemke(M, q, max_iter=QUANTECON_MAX_ITER)
-
-
-def _quantecon_read(raw: Any, M: FloatArray, q: FloatArray) -> Outcome:
-    """Outcome of ``lcp_lemke``; its residual is recomputed with our measure."""
-    return Outcome(
-        bool(raw.success),
-        QUANTECON_STATUS.get(int(raw.status), str(raw.status)),
-        int(raw.num_iter),
-        lcp_residual(M, q, raw.z),
-    )
-
-
-KERNEL = Entry("lemke_solve", "lemke_solve (compiled entry)", _kernel_solve, _kernel_read)
-QUANTECON = Entry(
-    "quantecon", "quantecon.optimize.lcp_lemke (compiled)", _quantecon_solve, _quantecon_read
-)
+KERNEL = Entry("lemke_solve", "lemke_solve (compiled entry)",
+               lambda M, q: lemke_solve(M, q, _LEMKE.max_iter, _LEMKE.pivot_tol, _LEMKE.tie_tol,
+                                        _LEMKE.tol), _kernel_read)
+QUANTECON = Entry("quantecon", "quantecon.optimize.lcp_lemke (compiled)",
+                  lambda M, q: lcp_lemke(M, q, max_iter=QUANTECON_MAX_ITER),
+                  lambda r, M, q: Outcome(bool(r.success),
+                                          QUANTECON_STATUS.get(int(r.status), str(r.status)),
+                                          int(r.num_iter), lcp_residual(M, q, r.z)))
 DRIVER_LEMKE = driver_entry("lemke")
 
 

@@ -20,103 +20,50 @@ import gymnasium as gym
 
 import mdi_envs
 from benchmarks import envs_report as R
-from benchmarks import report
-from benchmarks.timing import (
-    Progress,
-    TimingPlan,
-    arguments,
-    checkpoint,
-    finish,
-    load_text,
-    machine_info,
-    time_interleaved,
-)
+from benchmarks import report, timing
+from benchmarks.timing import Progress, TimingPlan
 
-ACROBOT = "Acrobot-v1"
-MUJOCO_PEER = "InvertedDoublePendulum-v5"
+ACROBOT, MUJOCO_PEER = "Acrobot-v1", "InvertedDoublePendulum-v5"
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
-
 VERSIONED = ("numpy", "numba", "llvmlite", "gymnasium", "mujoco", "mdi-envs")
-"""Distributions whose versions the JSON records."""
-
-TARGETS = {
-    "manipulator_step_us": 10.0,
-    "speedup_vs_acrobot": 3.0,
-    "manipulator_physics_steps_per_s": 5e6,
-    "manipulator_vector_copies": 4096,
-}
-"""The targets: manipulator ``env.step`` <= 10 µs, >= 3x faster than Acrobot-v1,
->= 5e6 physics steps/s of the manipulator vector env at num_envs = 4096 on one core."""
-
-UNITS = {
-    "*_s": "seconds",
-    "*_us": "microseconds",
-    "*_per_s": "per second (wall clock)",
-    "ratio_*": "dimensionless (peer time / our time; > 1: ours faster)",
-    "frame_skip": "physics steps per env step",
-    "num_envs": "copies in one vector env",
-    "rounds, number": "timed samples, calls per sample",
-    "steps_per_call": "env.step calls per call of a single-env loop (times are per step)",
-}
+TARGETS = {"manipulator_step_us": 10.0, "speedup_vs_acrobot": 3.0,
+           "manipulator_physics_steps_per_s": 5e6, "manipulator_vector_copies": 4096}
+UNITS = {"*_s": "seconds", "*_us": "microseconds", "*_per_s": "per second (wall clock)",
+         "ratio_*": "peer time / our time (> 1: ours faster)",
+         "frame_skip": "physics steps per env step", "num_envs": "copies in one vector env",
+         "rounds, number": "timed samples, calls per sample",
+         "steps_per_call": "env.step calls per timed call (times are per step)"}
 
 
 @dataclass(frozen=True)
 class EnvsConfig:
-    """Environments, grid and timing budgets of one run.
-
-    Attributes:
-        env_ids: our environments (None: every registered ``mdi_envs.ENV_IDS``).
-        peers: comparison environments timed like ours with ``gym.make`` (one that cannot be
-            made is recorded with the reason and skipped).
-        sync_peer: the environment timed in Gymnasium's ``"sync"`` vector mode (None: none).
-        sync_max_copies: largest N of the sync peer.
-        copies: the N of the vector study.
-        action_samples: pre-sampled actions (single) or action batches (vector), cycled.
-        step_plan: timing plan of the single-env study (all entries interleaved at once).
-        vector_plan: timing plan per N of the vector study.
-        cpu: CPU to pin the process to during the run (None: no pinning).
-        seed: seed of the resets and of the action spaces.
-    """
+    """Our env ids (None: all) and peers, vector N, action samples and timing of one run."""
 
     env_ids: tuple[str, ...] | None
     peers: tuple[str, ...]
-    sync_peer: str | None
-    sync_max_copies: int
     copies: tuple[int, ...]
     action_samples: int
     step_plan: TimingPlan
     vector_plan: TimingPlan
+    sync_peer: str | None = ACROBOT
+    sync_max_copies: int = 256
     cpu: int | None = 0
     seed: int = 0
 
 
 FULL = EnvsConfig(
-    env_ids=None,
-    peers=(ACROBOT, MUJOCO_PEER),
-    sync_peer=ACROBOT,
-    sync_max_copies=256,
-    copies=(1, 4, 16, 64, 256, 1024, 4096),
+    env_ids=None, peers=(ACROBOT, MUJOCO_PEER), copies=(1, 4, 16, 64, 256, 1024, 4096),
     action_samples=1024,
     step_plan=TimingPlan(budget_s=2.0, min_rounds=21, max_rounds=301, min_batch_s=5e-3),
-    vector_plan=TimingPlan(budget_s=2.0, min_rounds=21, max_rounds=61, min_batch_s=5e-3),
-)
+    vector_plan=TimingPlan(budget_s=2.0, min_rounds=21, max_rounds=61, min_batch_s=5e-3))
 QUICK = EnvsConfig(
-    env_ids=("mdi_envs/BlockableManipulator-v0",),
-    peers=(ACROBOT,),
-    sync_peer=ACROBOT,
-    sync_max_copies=256,
-    copies=(1, 16, 256),
-    action_samples=256,
+    env_ids=(MANIPULATOR,), peers=(ACROBOT,), copies=(1, 16, 256), action_samples=256,
     step_plan=TimingPlan(budget_s=0.2, min_rounds=9, max_rounds=51, min_batch_s=2e-3),
-    vector_plan=TimingPlan(budget_s=0.1, min_rounds=5, max_rounds=15, min_batch_s=2e-3),
-)
+    vector_plan=TimingPlan(budget_s=0.1, min_rounds=5, max_rounds=15, min_batch_s=2e-3))
 
 
 def frame_skip(env: Any) -> int:
-    """Physics steps per env step: ``scene.frame_skip`` for ours, ``frame_skip`` (MuJoCo) else 1.
-
-    Works on a single env, a vector env and a ``SyncVectorEnv`` (its first sub-env).
-    """
+    """Physics steps per env step: ``scene.frame_skip`` for ours, ``frame_skip`` (MuJoCo) else 1."""
     if hasattr(env, "envs"):
         env = env.envs[0]
     inner = env.unwrapped
@@ -147,21 +94,7 @@ STEPS_PER_CALL = 64
 
 
 class StepLoop:
-    """``steps_per_call`` calls of ``env.step`` per call, in a user's rollout loop.
-
-    A plain ``for`` loop over the next pre-sampled actions calling ``env.step`` and resetting
-    when an episode ends; each step carries its share of the loop and of the resets.
-
-    Args:
-        env: a reset single environment (wrapped or unwrapped).
-        actions: the pre-sampled actions, cycled.
-        max_steps: truncate after this many steps (for an unwrapped env without TimeLimit;
-            None: rely on the env's own ``truncated``).
-        steps_per_call: steps per call.
-
-    Attributes:
-        steps, episodes: steps taken and episodes ended so far.
-    """
+    """``steps_per_call`` calls of ``env.step`` with pre-sampled actions, reset when one ends."""
 
     def __init__(self, env: Any, actions: list[Any], max_steps: int | None = None,
                  steps_per_call: int = STEPS_PER_CALL) -> None:
@@ -212,11 +145,7 @@ def _error_text(error: BaseException) -> str:
 
 def _make_single(env_id: str, ours: bool, seed: int, samples: int
                  ) -> tuple[dict[str, Any], list[Any]]:
-    """Make the env twice (timed ``gym.make`` and unwrapped) and time the first calls.
-
-    Returns:
-        (the environment's record, [gym.make loop, unwrapped loop]).
-    """
+    """Make the env twice (timed ``gym.make`` and unwrapped) and time the first calls."""
     start = time.perf_counter()
     env = gym.make(env_id)
     make_s = time.perf_counter() - start
@@ -233,29 +162,18 @@ def _make_single(env_id: str, ours: bool, seed: int, samples: int
     bare.reset(seed=seed)
     spec = env.spec
     max_steps = spec.max_episode_steps if spec is not None else None
-    record = {
-        "env_id": env_id,
-        "ours": ours,
-        "wrappers": _wrapper_chain(env),
-        "frame_skip": frame_skip(env),
-        "dt_s": float(env.unwrapped.dt) if hasattr(env.unwrapped, "dt") else None,
-        "max_episode_steps": max_steps,
-        "action_space": str(env.action_space),
-        "first_make_s": make_s,
-        "first_reset_s": reset_s,
-        "first_step_s": first_step_s,
-    }
+    record = {"env_id": env_id, "ours": ours, "wrappers": _wrapper_chain(env),
+              "frame_skip": frame_skip(env),
+              "dt_s": float(env.unwrapped.dt) if hasattr(env.unwrapped, "dt") else None,
+              "max_episode_steps": max_steps, "action_space": str(env.action_space),
+              "first_make_s": make_s, "first_reset_s": reset_s, "first_step_s": first_step_s}
     return record, [StepLoop(env, actions), StepLoop(bare, actions, max_steps)]
 
 
 def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsConfig,
                      log: Callable[[str], None]
                      ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """``env.step`` through ``gym.make`` and unwrapped, for ours and the peers, interleaved.
-
-    Returns:
-        (one record per env that was made, one record per env that could not be made).
-    """
+    """``env.step`` through ``gym.make`` and unwrapped, for ours and the peers, interleaved."""
     records, unavailable, calls = [], [], {}
     loops: dict[str, StepLoop] = {}
     for env_id in (*env_ids, *peers):
@@ -270,34 +188,24 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
         records.append(record)
         loops[f"{env_id}|gym.make"] = wrapped
         loops[f"{env_id}|unwrapped"] = bare
-        log(f"  first step {record['first_step_s']:.2f} s, make {record['first_make_s']:.2f} s,"
-            f" frame_skip {record['frame_skip']}")
     calls.update(loops)
-    log(f"single env: {len(calls)} step loops, interleaved; load {load_text()} ...")
-    timed = time_interleaved(calls, config.step_plan)
+    log(f"single env: {len(calls)} step loops, interleaved; load {timing.load_text()} ...")
+    timed = timing.time_interleaved(calls, config.step_plan)
     for record in records:
         for entry in ("gym.make", "unwrapped"):
             key = f"{record['env_id']}|{entry}"
             loop = loops[key]
             summary = timed[key].summary(operations_per_call=loop.steps_per_call)
             record[entry] = {
-                "median_us": summary["median_s"] * 1e6,
-                "q1_us": summary["q1_s"] * 1e6,
-                "q3_us": summary["q3_s"] * 1e6,
-                "min_us": summary["min_s"] * 1e6,
-                "rounds": summary["rounds"],
-                "number": summary["number"],
-                "steps_per_call": loop.steps_per_call,
-                "steps_total": loop.steps,
-                "episodes_ended": loop.episodes,
-            }
+                **{f"{stat}_us": summary[f"{stat}_s"] * 1e6 for stat in ("median", "q1", "q3",
+                                                                         "min")},
+                "rounds": summary["rounds"], "number": summary["number"],
+                "steps_per_call": loop.steps_per_call, "steps_total": loop.steps,
+                "episodes_ended": loop.episodes}
         record["per_physics_step_us"] = record["gym.make"]["median_us"] / record["frame_skip"]
         loops[f"{record['env_id']}|gym.make"].env.close()
         loops[f"{record['env_id']}|unwrapped"].env.close()
     _add_ratios(records)
-    for r in records:
-        log(f"  {r['env_id']}: env.step {r['gym.make']['median_us']:.1f} µs (gym.make), "
-            f"{r['unwrapped']['median_us']:.1f} µs (unwrapped)")
     return records, unavailable
 
 
@@ -336,11 +244,7 @@ def _vector_entry(env_id: str, mode: str, num_envs: int, config: EnvsConfig
 
 def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str], None]
                  ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Env-steps/s and physics steps/s of each vector env per N, interleaved per N.
-
-    Returns:
-        (one record per (env, mode, N), one record per env/mode that could not be made).
-    """
+    """Env-steps/s and physics steps/s of each vector env per N, interleaved per N."""
     rows: list[dict[str, Any]] = []
     unavailable: list[dict[str, Any]] = []
     failed: set[str] = set()
@@ -363,7 +267,7 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str]
                 log(f"  {key} N = {n} not measured: {unavailable[-1]['error']}")
         if not loops:
             continue
-        timed = time_interleaved(loops, config.vector_plan)
+        timed = timing.time_interleaved(loops, config.vector_plan)
         measured = []
         for key, value in timed.items():
             summary = value.summary()
@@ -385,7 +289,7 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str]
         rows += measured
         log(f"vector N = {n}: " + ", ".join(
             f"{R.short_name(r['env_id'])} ({r['mode']}) {r['env_steps_per_s']:.3g} env-steps/s"
-            for r in measured) + f"; load {load_text()}")
+            for r in measured) + f"; load {timing.load_text()}")
     return rows, unavailable
 
 
@@ -461,7 +365,7 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
     try:
         env_ids = tuple(config.env_ids if config.env_ids is not None else mdi_envs.ENV_IDS)
         record: dict[str, Any] = {
-            "machine": machine_info(VERSIONED),
+            "machine": timing.machine_info(VERSIONED),
             "pinning": pinning,
             "numba_threading": _numba_info(),
             "config": {"quick": quick, "env_ids": env_ids,
@@ -472,12 +376,12 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
             "load_log": [],
         }
         log(f"env benchmark ({'quick' if quick else 'full'}) -> {output}; pinned to "
-            f"{pinning['cpus']}; load {load_text()}")
-        checkpoint(record, "single env", progress.elapsed)
+            f"{pinning['cpus']}; load {timing.load_text()}")
+        timing.checkpoint(record, "single env", progress.elapsed)
         single, unavailable = single_env_study(env_ids, config.peers, config, log)
-        checkpoint(record, "vector env", progress.elapsed)
+        timing.checkpoint(record, "vector env", progress.elapsed)
         vector, vector_unavailable = vector_study(env_ids, config, log)
-        checkpoint(record, "end", progress.elapsed)
+        timing.checkpoint(record, "end", progress.elapsed)
         for item in (*unavailable, *vector_unavailable):
             record["notes"].append(f"{item['env_id']}"
                                    f"{' (' + item['mode'] + ')' if 'mode' in item else ''} "
@@ -491,7 +395,7 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
         })
         R.plot_step(single, unavailable, TARGETS, output / "envs_step.png")
         R.plot_vector(vector, TARGETS, output / "envs_vector.png")
-        finish(record, progress.elapsed, speed=True)
+        timing.finish(record, progress.elapsed, speed=True)
         report.write_json(record, output / "envs.json")
         log(f"done in {progress.elapsed:.0f} s; wrote envs.json, envs_step.png and "
             f"envs_vector.png to {output}")
@@ -503,13 +407,9 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    args = arguments(__doc__, argv, "N up to 256 and small budgets (the JIT compile dominates)",
-                     "results/bench",
-                     extra=lambda parser: parser.add_argument(
-                         "--cpu", type=int, default=0,
-                         help="CPU to pin the process to (-1: no pinning)"))
-    config = QUICK if args.quick else FULL
-    config = replace(config, cpu=None if args.cpu < 0 else args.cpu)
+    args = timing.arguments(__doc__, argv, ("--cpu", {"type": int, "default": 0,
+                                                      "help": "CPU to pin to (-1: none)"}))
+    config = replace(QUICK if args.quick else FULL, cpu=None if args.cpu < 0 else args.cpu)
     print(run(config, args.output, args.quick))
 
 

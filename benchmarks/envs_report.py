@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.report import plt, save_figure, summary
+from benchmarks.report import log_lines, plt, save_figure, summary
 
 SHORT_NAMES = {
     "mdi_envs/BlockableManipulator-v0": "BlockableManipulator",
@@ -81,42 +81,16 @@ def plot_vector(vector: Sequence[dict[str, Any]], targets: Mapping[str, float], 
                 ) -> None:
     """Env-steps/s and physics steps/s against num_envs (log-log), with the target line."""
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
-    columns = list(dict.fromkeys((r["env_id"], r["mode"]) for r in vector))
-    sizes = sorted({r["num_envs"] for r in vector})
-    manipulator_skip = None
-    for ax, key, title in ((axes[0], "env_steps_per_s", "env-steps/s"),
-                           (axes[1], "physics_steps_per_s", "physics steps/s (× frame_skip)")):
-        for env_id, mode in columns:
-            rows = sorted((r for r in vector if r["env_id"] == env_id and r["mode"] == mode),
-                          key=lambda r: r["num_envs"])
-            if env_id == "mdi_envs/BlockableManipulator-v0":
-                manipulator_skip = rows[0]["frame_skip"]
-            n = [r["num_envs"] for r in rows]
-            style = "--" if mode == "sync" else "-"
-            (line,) = ax.plot(n, [r[key] for r in rows], style, marker="o", ms=4,
-                              label=f"{short_name(env_id)} ({mode}, frame_skip "
-                              f"{rows[0]['frame_skip']})")
-            ax.fill_between(n, [r[f"{key}_q1"] for r in rows], [r[f"{key}_q3"] for r in rows],
-                            color=line.get_color(), alpha=0.15)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ticks = sorted({*sizes, targets["manipulator_vector_copies"]} if key.startswith("phys")
-                       else set(sizes))
-        if ticks:
-            ax.set_xticks(ticks, [str(s) for s in ticks])
-        ax.minorticks_off()
+    rows = [{**r, "line": f"{short_name(r['env_id'])} ({r['mode']}, frame_skip "
+             f"{r['frame_skip']})"} for r in vector]
+    for ax, key in zip(axes, ("env_steps_per_s", "physics_steps_per_s"), strict=True):
+        log_lines(ax, rows, "num_envs", key, "line", (f"{key}_q1", f"{key}_q3"),
+                  dashed=lambda line: "(sync" in line)
         ax.set_xlabel("num_envs N (one core)")
-        ax.set_ylabel(f"{title} (median; band: quartiles)")
-        ax.grid(True, which="both", alpha=0.3)
-    goal = targets["manipulator_physics_steps_per_s"]
-    at = targets["manipulator_vector_copies"]
+        ax.set_ylabel(f"{key.replace('_', ' ')} (median; band: quartiles)")
+    goal, at = targets["manipulator_physics_steps_per_s"], targets["manipulator_vector_copies"]
     axes[1].axhline(goal, color="k", ls=":", lw=1.2,
                     label=f"target: manipulator ≥ {goal:.0e} physics steps/s at N = {at}")
-    axes[1].plot([at], [goal], "k*", ms=10)
-    if manipulator_skip:
-        axes[0].axhline(goal / manipulator_skip, color="k", ls=":", lw=1.2,
-                        label=f"the same target in manipulator env-steps/s "
-                        f"({goal / manipulator_skip:.1e}, frame_skip {manipulator_skip})")
     axes[0].set_title("Vector env throughput: env-steps/s")
     axes[1].set_title("Vector env throughput: physics steps/s")
     for ax in axes:

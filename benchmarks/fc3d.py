@@ -152,7 +152,7 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    args = arguments(__doc__, argv, f"only problems with n <= {QUICK_MAX_N}", "results/bench")
+    args = arguments(__doc__, argv)
     print(run(args.output, args.quick))
 
 

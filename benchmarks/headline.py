@@ -31,11 +31,7 @@ def stress_row(record: dict[str, Any]) -> dict[str, Any]:
 
 
 def engine_peer_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
-    """Ours against MuJoCo's arm in the engine run.
-
-    Rows: µs per copy-step at the largest N (the ratio MuJoCo / ours: above 1, ours is faster)
-    and the steps the brake takes to stop relative motion (ours against MuJoCo's eq_active).
-    """
+    """Ours against MuJoCo's arm in the engine run."""
     rows = []
     largest: dict[str, dict[str, Any]] = {}
     for entry in record.get("batched") or []:
@@ -71,11 +67,7 @@ def _number(value: Any) -> str:
 
 
 def write_headline(folder: Path) -> str:
-    """Write ``headline.json`` and ``headline.md`` from the results in ``folder``.
-
-    Returns:
-        The Markdown table (also when no result file is present: then it says so).
-    """
+    """Write ``headline.json`` and ``headline.md`` from the results in ``folder``."""
     folder = Path(folder)
     rows: list[dict[str, Any]] = []
     runs = {}

@@ -29,15 +29,7 @@ Generator = Callable[[np.random.Generator, int], tuple[FloatArray, FloatArray]]
 
 @dataclass(frozen=True)
 class Problem:
-    """One LCP instance of the benchmark.
-
-    Attributes:
-        name: unique label (``"spd-n20-i0"`` or the peer file's stem).
-        family: ``"spd"``, ``"contact"`` or ``"siconos"``.
-        n: size.
-        M: (n, n) C-contiguous float64 matrix.
-        q: (n,) float64 vector.
-    """
+    """One LCP instance of the benchmark."""
 
     name: str
     family: str

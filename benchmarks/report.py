@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -19,29 +19,9 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 
-def format_us(seconds: float) -> str:
-    """Seconds as microseconds with about three significant digits (``"1,430"``, ``"12.3"``)."""
-    us = seconds * 1e6
-    if us < 9.995:
-        return f"{us:.2f}"
-    return f"{us:.1f}" if us < 99.95 else f"{us:,.0f}"
-
-
-def format_us_fine(seconds: float | None) -> str:
-    """Seconds as µs, with three significant digits below 1 µs (``"0.0512"``); ``–`` if absent."""
-    if seconds is None or not np.isfinite(seconds):
-        return "–"
-    return f"{seconds * 1e6:.3g}" if seconds < 1e-6 else format_us(seconds)
-
-
-def format_ratio(ratio: float) -> str:
-    """A time ratio with two decimals (or two significant digits when tiny)."""
-    return f"{ratio:.2f}" if ratio >= 0.1 else f"{ratio:.2g}"
-
-
-def format_residual(residual: float, digits: int = 1) -> str:
-    """A residual in exponent notation, or ``0`` when exactly zero."""
-    return "0" if residual == 0.0 else f"{residual:.{digits}e}"
+def format_us(seconds: float | None) -> str:
+    """Seconds as µs with three significant digits (``"0.0512"``); ``–`` if absent."""
+    return "–" if seconds is None or not np.isfinite(seconds) else f"{seconds * 1e6:.3g}"
 
 
 def format_number(value: float | None) -> str:
@@ -54,12 +34,7 @@ def format_number(value: float | None) -> str:
 
 
 def markdown_table(rows: Iterable[Any], columns: Sequence[str] | None = None) -> str:
-    """A GitHub Markdown table (pandas ``DataFrame.to_markdown``); cells are written as given.
-
-    Args:
-        rows: dicts (column -> cell) or sequences of cells in the order of ``columns``.
-        columns: the header (default: the dicts' keys).
-    """
+    """A GitHub Markdown table (pandas ``DataFrame.to_markdown``); cells are written as given."""
     frame = pd.DataFrame(list(rows), columns=list(columns) if columns is not None else None)
     return frame.to_markdown(index=False, disable_numparse=True)
 
@@ -74,9 +49,9 @@ def flat_table(rows: Iterable[Mapping[str, Any]], columns: Sequence[str] | None 
 
 def summary(record: Mapping[str, Any], packages: Sequence[str],
             sections: Mapping[str, Any]) -> str:
-    """A run's stdout report: run line, notes, targets, then per section title its table.
+    """A run's stdout report: run line, notes, targets, then per title a table of records.
 
-    A section is a list of records (``flat_table``), a (records, columns) pair or ready text.
+    A section is records (``flat_table``), a (records, columns) pair, or ready text.
     """
     lines = [run_line(record, packages), *(f"* {note}" for note in record.get("notes") or [])]
     if record.get("targets"):
@@ -96,16 +71,54 @@ def save_figure(fig: Any, path: Path, dpi: int = 130) -> None:
     plt.close(fig)
 
 
+def log_lines(ax: Any, rows: Sequence[Mapping[str, Any]], x: str, y: str, group: str,
+              band: tuple[str, str] | None = None, scale: float = 1.0,
+              label: Callable[[Any], str] = str, dashed: Callable[[Any], bool] = bool,
+              ticks: bool = True) -> None:
+    """A log-log panel: ``y * scale`` against ``x``, one line per value of ``group``.
+
+    ``band`` names the low and high keys of a shaded band; ``dashed(group)`` dashes a line;
+    ``ticks`` marks every x value.
+    """
+    for key in dict.fromkeys(r[group] for r in rows):
+        chosen = sorted((r for r in rows if r[group] == key), key=lambda r: r[x])
+        xs = [r[x] for r in chosen]
+        (line,) = ax.plot(xs, [r[y] * scale for r in chosen], "--" if dashed(key) else "-",
+                          marker="o", ms=4, label=label(key))
+        if band:
+            ax.fill_between(xs, [r[band[0]] * scale for r in chosen],
+                            [r[band[1]] * scale for r in chosen], color=line.get_color(),
+                            alpha=0.15)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    if ticks:
+        values = sorted({r[x] for r in rows})
+        ax.set_xticks(values, [f"{t:g}" for t in values])
+        ax.minorticks_off()
+    ax.grid(True, which="both", alpha=0.3)
+
+
+def bars(ax: Any, labels: Sequence[str], series: Mapping[str, Sequence[float | None]],
+         xlabel: str, log: bool = True) -> None:
+    """Grouped horizontal bars, one group per label (top to bottom), one bar per series."""
+    y = np.arange(len(labels))
+    height = 0.8 / max(len(series), 1)
+    for i, (name, values) in enumerate(series.items()):
+        ax.barh(y + (i - (len(series) - 1) / 2) * height,
+                [np.nan if v is None else v for v in values], height, label=name)
+    if log:
+        ax.set_xscale("log")
+    ax.set_yticks(y, labels, fontsize=7 if len(labels) > 20 else 8)
+    ax.invert_yaxis()
+    ax.set_xlabel(xlabel)
+    ax.grid(True, axis="x", which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, frameon=False)
+
+
 def target_row(name: str, comparison: str, threshold: float | None, unit: str,
                measured: float | None, note: str = "", met: bool | None = None
                ) -> dict[str, Any]:  # fmt: skip
-    """One target check; ``met`` is judged from ``comparison`` unless given (None: not measured).
-
-    Args:
-        name: what is measured. comparison: ``"≤"``, ``"≥"`` or ``""`` (no limit).
-        threshold: the limit in ``unit``. measured: the value in ``unit`` (None: not measured).
-        note: context. met: an explicit verdict (e.g. None where only a bound was measured).
-    """
+    """One target check; ``met`` judged from ``comparison`` ("≤", "≥" or "") unless given."""
     if met is None and measured is not None and comparison in ("≤", "≥"):
         met = bool(measured <= threshold) if comparison == "≤" else bool(measured >= threshold)
     return {"target": name, "comparison": comparison, "threshold": threshold, "unit": unit,
@@ -113,11 +126,9 @@ def target_row(name: str, comparison: str, threshold: float | None, unit: str,
 
 
 def target_value(value: float | None, unit: str) -> str:
-    """A target's value with its unit: µs with ``format_us_fine``, ratios as ``12.3×``."""
+    """A target's value with its unit, ratios as ``12.3×``."""
     if value is None:
         return "–"
-    if unit == "µs":
-        return f"{format_us_fine(value * 1e-6)} µs"
     if unit == "×":
         return f"{value:.3g}×"
     return f"{format_number(value)} {unit}".strip()
@@ -144,32 +155,18 @@ def run_line(record: Mapping[str, Any], packages: Sequence[str]) -> str:
     machine = record["machine"]
     versions = ", ".join(f"{name} {machine['versions'].get(name)}" for name in packages)
     quick = " (--quick)" if record["config"]["quick"] else ""
+    loads = ["/".join(f"{x:.2f}" for x in machine.get(f"load_average_at_{when}") or [])
+             for when in ("start", "end")]
+    probes = [f"{probe['fastest_us']:.2f} µs fastest, {probe['median_us']:.2f} µs median at {when}"
+              for when in ("start", "end") if (probe := machine.get(f"speed_probe_at_{when}"))]
     return (f"Run {machine['date']} on {machine['cpu_model']} ({machine['cpu_count']} CPUs), "
-            f"{versions}; total {record['run_time_s']:.0f} s{quick}; "
-            f"{load_average_text(machine)}; {machine_speed_text(machine)}.")
-
-
-def load_average_text(machine: Mapping[str, Any]) -> str:
-    """The machine record's load averages at start and end of a run, as one phrase."""
-    start, end = (machine.get(f"load_average_at_{when}") or [] for when in ("start", "end"))
-    return (f"load average (1/5/15 min) {'/'.join(f'{x:.2f}' for x in start)} at start, "
-            f"{'/'.join(f'{x:.2f}' for x in end)} at end")
-
-
-def machine_speed_text(machine: Mapping[str, Any]) -> str:
-    """The machine record's speed probes (``timing.speed_probe``) at start and end, as a phrase."""
-    parts = [f"{probe['fastest_us']:.2f} µs fastest, {probe['median_us']:.2f} µs median, "
-             f"{probe['slow_fraction']:.0%} of batches slow (> 1.5× the fastest) at {when}"
-             for when in ("start", "end") if (probe := machine.get(f"speed_probe_at_{when}"))]
-    return ("machine speed probe (a compiled no-op called from Python): " + "; ".join(parts)
-            if parts else "no machine speed probe")
+            f"{versions}; total {record['run_time_s']:.0f} s{quick}; load average "
+            f"{loads[0]} at start, {loads[1]} at end; speed probe (a compiled no-op): "
+            + ("; ".join(probes) or "none") + ".")
 
 
 def json_safe(value: Any) -> Any:
-    """``value`` as strict JSON: non-finite floats as the strings "inf", "-inf", "nan".
-
-    A diverged measurement thus stays visible; numpy scalars become Python numbers, tuples lists.
-    """
+    """``value`` as strict JSON: non-finite floats as the strings "inf", "-inf", "nan"."""
     if isinstance(value, dict):
         return {k: json_safe(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -186,6 +183,6 @@ def write_json(record: dict[str, Any], path: Path) -> None:
     path.write_text(json.dumps(record, indent=1, default=lambda v: v.item()) + "\n")
 
 
-__all__ = ["flat_table", "format_number", "format_ratio", "format_residual", "format_us",
-           "format_us_fine", "json_safe", "markdown_table", "plt", "run_line", "save_figure",
-           "summary", "target_row", "targets_table", "write_json"]
+__all__ = ["bars", "flat_table", "format_number", "format_us", "json_safe", "log_lines",
+           "markdown_table", "plt", "run_line", "save_figure", "summary", "target_row",
+           "targets_table", "write_json"]

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks import entries as E
-from benchmarks import report
+from benchmarks import report, timing
 from benchmarks import solvers_report as R
 from benchmarks.problems import (
     FAMILIES,
@@ -24,32 +24,12 @@ from benchmarks.problems import (
     peer_lcp_problems,
     random_problem,
 )
-from benchmarks.timing import (
-    Progress,
-    TimingPlan,
-    arguments,
-    finish,
-    machine_info,
-    probe_first_calls,
-    time_interleaved,
-)
-
-SIZE_STUDY_COLUMNS = (*E.LCP_METHODS, E.QUANTECON.name)
+from benchmarks.timing import Progress, TimingPlan
 
 
 @dataclass(frozen=True)
 class BenchConfig:
-    """Grid and timing budgets of one run.
-
-    Attributes:
-        sizes: n of the work-size study.
-        instances: random instances per (family, n) in the work-size study.
-        size_plan: timing plan per problem of the work-size study.
-        peer_sizes: n of the random problems of the QuantEcon comparison.
-        peer_instances: random instances per (family, n) in the QuantEcon comparison.
-        peer_plan: timing plan per problem of the QuantEcon comparison (and the fixed cost).
-        cold_compile: also measure first calls with an empty numba cache (about 30 s).
-    """
+    """Grid and timing budgets of one run."""
 
     sizes: tuple[int, ...]
     instances: int
@@ -88,7 +68,7 @@ def measure_first_calls(config: BenchConfig, log: Progress) -> dict[str, Any]:
     results = {}
     for label, cold in probes.items():
         log(f"first-call probe ({label}) in a fresh interpreter ...")
-        results[label] = probe_first_calls(cold)
+        results[label] = timing.probe_first_calls(cold)
         calls = results[label].get("first_call_s", {})
         log("  " + ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in calls.items()))
     return results
@@ -102,13 +82,9 @@ def warm_up(all_entries: Sequence[E.Entry]) -> None:
 
 
 def time_problem(problem: Problem, chosen: Sequence[E.Entry], plan: TimingPlan) -> dict[str, Any]:
-    """Time entries on one problem in interleaved rounds and read their outcomes.
-
-    Returns:
-        entry name -> {"time": ``Timed.summary()``, "outcome": ``Outcome`` as dict}.
-    """
+    """Time entries on one problem in interleaved rounds and read their outcomes."""
     calls = {e.name: (lambda e=e: e.solve(problem.M, problem.q)) for e in chosen}
-    timed = time_interleaved(calls, plan)
+    timed = timing.time_interleaved(calls, plan)
     return {
         e.name: {
             "time": timed[e.name].summary(),
@@ -162,11 +138,7 @@ FIXED_COST_PROBLEMS = (
 
 def compare_lemke(problems: Sequence[Problem], plan: TimingPlan, log: Progress
                   ) -> list[dict[str, Any]]:  # fmt: skip
-    """Our Lemke (driver and compiled entry) against QuantEcon's, interleaved, per problem.
-
-    Each row: name, family, n, per entry (``driver``, ``kernel``, ``quantecon``) its time and
-    outcome, and the time ratios ``ratio_driver`` and ``ratio_kernel`` (ours / QuantEcon).
-    """
+    """Our Lemke (driver and compiled entry) against QuantEcon's, interleaved, per problem."""
     keys = {"driver": E.DRIVER_LEMKE, "kernel": E.KERNEL, "quantecon": E.QUANTECON}
     rows = []
     for problem in problems:
@@ -188,7 +160,7 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
     log = Progress()
     output.mkdir(parents=True, exist_ok=True)
     record: dict[str, Any] = {
-        "machine": machine_info(),
+        "machine": timing.machine_info(),
         "config": {"quick": quick, **asdict(config)},
     }
     log(f"LCP solver benchmark ({'quick' if quick else 'full'}) -> {output}")
@@ -206,12 +178,10 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
         "problems": rows,
         "median_ratios": summary,
     }
-    R.plot_by_entry(aggregates, SIZE_STUDY_COLUMNS, output / "solvers_time_vs_size.png",
-                    "time_median_s")
-    R.plot_by_entry(aggregates, SIZE_STUDY_COLUMNS, output / "solvers_residual_vs_size.png",
-                    "residual_max")
+    R.plot_by_entry(aggregates, output / "solvers_time_vs_size.png", "time_median_s")
+    R.plot_by_entry(aggregates, output / "solvers_residual_vs_size.png", "residual_max")
     R.plot_ratios(rows, output / "lemke_vs_quantecon.png")
-    finish(record, log.elapsed)
+    timing.finish(record, log.elapsed)
     report.write_json(record, output / "solvers.json")
     log(f"done in {log.elapsed:.0f} s; wrote solvers.json and 3 plots to {output}")
     return R.markdown_report(record)
@@ -219,7 +189,7 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """Command-line entry point."""
-    args = arguments(__doc__, argv, "small grid and budgets (~10 s)", "results/bench")
+    args = timing.arguments(__doc__, argv)
     print(run(QUICK if args.quick else FULL, args.output, args.quick))
 
 

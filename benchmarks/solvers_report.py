@@ -7,9 +7,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.ticker import NullFormatter
 
-from benchmarks.report import plt, save_figure, summary
+from benchmarks.report import bars, log_lines, plt, save_figure, summary
 
 ENTRY_KEYS = ("driver", "kernel", "quantecon")
 """Keys of the three timed entries in each row of the QuantEcon comparison."""
@@ -25,17 +24,7 @@ def _median(values: Iterable[float]) -> float:
 
 
 def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Combine the instances of each (family, n, entry) of the work-size study.
-
-    Args:
-        records: one dict per (family, n, instance, entry) with ``time`` (a ``Timed.summary``)
-            and ``outcome`` (an ``Outcome`` as dict).
-
-    Returns:
-        One dict per (family, n, entry): the median over instances of the per-instance median
-        time, its min and max over instances, the largest residual, the median iteration
-        count and how many instances the entry solved.
-    """
+    """Combine the instances of each (family, n, entry) of the work-size study."""
     groups: dict[tuple[str, int, str], list[dict[str, Any]]] = {}
     for record in records:
         groups.setdefault((record["family"], record["n"], record["entry"]), []).append(record)
@@ -52,11 +41,7 @@ def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, An
 
 
 def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Median time ratios ours/QuantEcon over problem sets, for both of our entry points.
-
-    Sets: the Siconos peer files, all random problems, each random family, and the peer files
-    that all three entries solved.
-    """
+    """Median time ratios ours/QuantEcon over problem sets, for both of our entry points."""
     solved = [r for r in rows if all(r[k]["outcome"]["success"] for k in ENTRY_KEYS)]
     sets = {
         "Siconos peer files": [r for r in rows if r["family"] == "siconos"],
@@ -96,40 +81,23 @@ def markdown_report(record: dict[str, Any]) -> str:
     })
 
 
-def plot_by_entry(aggregates: Sequence[dict[str, Any]], entries: Sequence[str], path: Path,
-                  value: str) -> None:
+def plot_by_entry(aggregates: Sequence[dict[str, Any]], path: Path, value: str) -> None:
     """One log-log panel per family, one line per entry, against n.
 
-    ``value`` is ``time_median_s`` (band: min..max over instances) or ``residual_max`` (zeros
-    drawn at ``RESIDUAL_FLOOR``, the tolerance marked).
+    ``value`` is ``time_median_s`` (band: min..max over instances) or ``residual_max``.
     """
     families = list(dict.fromkeys(r["family"] for r in aggregates))
-    sizes = sorted({r["n"] for r in aggregates})
     fig, axes = plt.subplots(1, len(families), figsize=(5.5 * len(families), 4.2), sharey=True)
     axes = list(np.atleast_1d(axes))
+    floored = [{**r, value: max(r[value], RESIDUAL_FLOOR)} for r in aggregates]
     for ax, family in zip(axes, families, strict=True):
-        for entry in entries:
-            rows = sorted((r for r in aggregates if r["family"] == family
-                           and r["entry"] == entry), key=lambda r: r["n"])
-            if not rows:
-                continue
-            n = [r["n"] for r in rows]
-            (line,) = ax.plot(n, [max(r[value], RESIDUAL_FLOOR) for r in rows],
-                              "k--" if entry == "quantecon" else "-", marker="o", ms=4,
-                              label=ENTRY_TITLES.get(entry, entry))
-            if value == "time_median_s":
-                ax.fill_between(n, [r["time_min_s"] for r in rows],
-                                [r["time_max_s"] for r in rows], color=line.get_color(),
-                                alpha=0.15)
+        log_lines(ax, [r for r in floored if r["family"] == family], "n", value, "entry",
+                  ("time_min_s", "time_max_s") if value == "time_median_s" else None,
+                  label=lambda e: ENTRY_TITLES.get(e, e), dashed=lambda e: e == "quantecon")
         if value == "residual_max":
             ax.axhline(1e-10, color="grey", lw=0.8, ls=":", label="tol 1e-10")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xticks(sizes, [str(n) for n in sizes])
-        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_title(f"family {family!r}")
         ax.set_xlabel("n")
-        ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("time per solve (s)" if value == "time_median_s"
                        else "largest residual (0 drawn at 1e-18)")
     axes[-1].legend(fontsize=8)
@@ -138,17 +106,12 @@ def plot_by_entry(aggregates: Sequence[dict[str, Any]], entries: Sequence[str], 
 
 def plot_ratios(rows: Sequence[dict[str, Any]], path: Path) -> None:
     """Horizontal bars of the time ratio ours/QuantEcon per problem, for both entry points."""
-    y = np.arange(len(rows))
     fig, ax = plt.subplots(figsize=(9.0, 0.22 * len(rows) + 1.8))
-    ax.barh(y - 0.2, [r["ratio_driver"] for r in rows], 0.4, label="solve_lcp driver / QE")
-    ax.barh(y + 0.2, [r["ratio_kernel"] for r in rows], 0.4, label="lemke_solve / QE")
     ax.axvline(1.0, color="k", lw=0.8)
-    ax.set_xscale("log")
-    ax.set_yticks(y, [_ratio_label(r) for r in rows], fontsize=7)
-    ax.invert_yaxis()
-    ax.set_xlabel("time ratio ours / QuantEcon lcp_lemke (< 1: ours faster)")
-    ax.grid(True, axis="x", which="both", alpha=0.3)
-    ax.legend(fontsize=8, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, frameon=False)
+    bars(ax, [_ratio_label(r) for r in rows], {
+        "solve_lcp driver / QE": [r["ratio_driver"] for r in rows],
+        "lemke_solve / QE": [r["ratio_kernel"] for r in rows]},
+        "time ratio ours / QuantEcon lcp_lemke (< 1: ours faster)")
     save_figure(fig, path)
 
 

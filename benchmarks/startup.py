@@ -8,7 +8,6 @@ beside Acrobot-v1 and InvertedDoublePendulum-v5. Writes ``startup.json`` and ``s
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -44,11 +43,7 @@ def _environment(cache: Path | None, python_path: Path | None) -> dict[str, str]
 
 def time_to_first_step(entry: str, env_id: str, cache: Path | None,
                        python_path: Path | None = None) -> dict[str, Any]:
-    """Seconds from starting a fresh interpreter to its first ``step`` returned, and phases.
-
-    ``cache``: the kernel cache root (None: the user's). Returns ``{"error": ...}`` if the
-    probe failed.
-    """
+    """Seconds from starting a fresh interpreter to its first ``step`` returned, and phases."""
     started = time.time()
     process = subprocess.run(
         [sys.executable, "-m", "benchmarks.startup_probe", entry, env_id], cwd=ROOT,
@@ -220,13 +215,9 @@ def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point."""
-    def extra(parser: argparse.ArgumentParser) -> None:
-        parser.add_argument("--python-path", type=Path, default=None,
-                            help="run the probes on the package in this folder (PYTHONPATH)")
-        parser.add_argument("--repeats", type=int, default=5, help="warm repetitions (full run)")
-
-    args = arguments(__doc__, argv, "warm single and vector cases once, on the user's cache",
-                     "results/bench", extra)
+    args = arguments(__doc__, argv, ("--python-path", {"type": Path, "help": "probe the package "
+                                                       "in this folder (PYTHONPATH)"}),
+                     ("--repeats", {"type": int, "default": 5, "help": "warm repetitions"}))
     print(run(args.quick, args.output, args.python_path, args.repeats))
     record = json.loads((args.output / "startup.json").read_text())
     failed = [key for key, summary in record["warm"].items() if "errors" in summary]

@@ -44,13 +44,7 @@ class _Collector:
 
 
 def run(output: Path, quick: bool) -> dict[str, Any]:
-    """Run every stress case, write ``stress.json`` and ``stress.png`` to ``output``.
-
-    Returns:
-        The record written: ``machine``, ``config``, ``notes``, ``cases`` (each with parameters,
-        metrics, criteria and ``passed``), ``passed``, ``num_cases``, ``num_failed``,
-        ``compile_s`` and ``run_time_s``; ``pytest_exit_code`` when pytest itself failed.
-    """
+    """Run every stress case, write ``stress.json`` and ``stress.png`` to ``output``."""
     start = time.perf_counter()
     machine = machine_info()
     collector = _Collector()
@@ -76,11 +70,7 @@ def run(output: Path, quick: bool) -> dict[str, Any]:
 
 
 def margin(criterion: Mapping[str, Any]) -> float:
-    """How close a criterion is to failing: < 1 passes, > 1 fails (``value / limit`` for ``<=``).
-
-    Zero values against a zero limit (e.g. no NaN counted) give ``MARGIN_FLOOR``; positive values
-    against a zero limit, and non-finite values, give ``MARGIN_CEILING``.
-    """
+    """How close a criterion is to failing: < 1 passes, > 1 fails (``value / limit`` for ``<=``)."""
     value, limit = float(criterion["value"]), float(criterion["limit"])
     if not math.isfinite(value):
         return MARGIN_CEILING
@@ -159,7 +149,7 @@ def plot_margins(cases: Sequence[Mapping[str, Any]], path: Path) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns 1 if any case fails, else 0."""
-    args = arguments(__doc__, argv, "the quick configuration: block and manipulator only")
+    args = arguments(__doc__, argv)
     record = run(args.output, args.quick)
     print(markdown_report(record))
     return 0 if record["passed"] else 1

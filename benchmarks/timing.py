@@ -30,14 +30,7 @@ from mdi_envs.provenance import git_commit
 
 @dataclass(frozen=True)
 class TimingPlan:
-    """How long to time one problem.
-
-    Attributes:
-        budget_s: target total time per callable (rounds x number x time per call).
-        min_rounds: rounds taken however slow the callables are.
-        max_rounds: rounds cap however fast they are.
-        min_batch_s: shortest batch of back-to-back calls timed as one sample.
-    """
+    """How long to time one problem."""
 
     budget_s: float
     min_rounds: int
@@ -47,16 +40,7 @@ class TimingPlan:
 
 @dataclass(frozen=True)
 class Timed:
-    """Timing of one callable on one problem.
-
-    Attributes:
-        result: the raw return value of the untimed warm-up call.
-        median_s: median time per call over the rounds (seconds).
-        min_s: fastest time per call over the rounds.
-        q1_s, q3_s: quartiles of the time per call over the rounds.
-        rounds: number of timed samples.
-        number: calls per sample.
-    """
+    """One callable's warm-up ``result`` and time per call [s] over ``rounds`` of ``number``."""
 
     result: Any
     median_s: float
@@ -67,12 +51,7 @@ class Timed:
     number: int
 
     def summary(self, operations_per_call: int = 1) -> dict[str, float | int]:
-        """The timing fields (not the result) as a JSON-ready dict.
-
-        Args:
-            operations_per_call: how many of the measured operations one call of the callable
-                makes; the times are divided by it (per operation).
-        """
+        """The times as a JSON-ready dict, per operation (``operations_per_call`` per call)."""
         per = operations_per_call
         return {
             "median_s": self.median_s / per,
@@ -92,14 +71,10 @@ def _timed_call(call: Callable[[], Any]) -> tuple[Any, float]:
 
 
 def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -> dict[str, Timed]:
-    """Time several callables in interleaved rounds (see the module docstring).
+    """Time callables (name -> zero-argument call) in interleaved rounds; name -> ``Timed``.
 
-    Args:
-        calls: name -> zero-argument callable.
-        plan: budget and repeat limits.
-
-    Returns:
-        name -> ``Timed``, in the order of ``calls``.
+    Each gets one untimed warm-up call, then per round a batch of ``number`` calls lasting at
+    least ``plan.min_batch_s``; the time per call is the median over rounds of batch / number.
     """
     warm = {name: _timed_call(call) for name, call in calls.items()}
     numbers = {
@@ -123,16 +98,7 @@ def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -
 
 
 def probe_first_calls(cold: bool) -> dict[str, Any]:
-    """Run ``benchmarks.first_call`` in a fresh interpreter and return its JSON report.
-
-    Args:
-        cold: point ``NUMBA_CACHE_DIR`` at an empty temporary folder, so every kernel is
-            compiled from scratch (true JIT time); otherwise use the ordinary on-disk cache
-            (what a user sees from the second run on).
-
-    Returns:
-        The probe's report, or ``{"error": ...}`` if the subprocess failed.
-    """
+    """Run ``benchmarks.first_call`` in a fresh interpreter and return its JSON report."""
     env = dict(os.environ)
     with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache_dir:
         if cold:  # numba's cache for other code, the package's own (mdi_envs._kernel_cache)
@@ -180,14 +146,7 @@ def load_average() -> list[float] | None:
 
 
 def speed_probe(samples: int = 200, number: int = 5000) -> dict[str, float]:
-    """How fast this machine runs right now: a compiled no-op called from Python.
-
-    Times ``samples`` batches of ``number`` calls of a numba function of one array (dispatch
-    only). On a shared VM other tenants slow every instruction in phases of seconds (the
-    benchmark VM: about 2x; CPU time inflates as much as wall time, so it is not
-    descheduling), which moves every median of a run. Returns the fastest and the median time
-    per call [us] and the fraction of batches slower than 1.5x the fastest.
-    """
+    """How fast this machine runs right now: a compiled no-op called from Python."""
     from numba import njit  # here: the timing helpers do not otherwise need numba
 
     @njit
@@ -234,17 +193,16 @@ def finish(record: dict[str, Any], elapsed_s: float, speed: bool = False) -> Non
     record["run_time_s"] = elapsed_s
 
 
-def arguments(doc: str | None, argv: Sequence[str] | None, quick: str,
-              default_output: str = "benchmarks/results",
-              extra: Callable[[argparse.ArgumentParser], Any] | None = None
-              ) -> argparse.Namespace:  # fmt: skip
-    """The command line of a benchmark module: ``--output``, ``--quick`` (and ``extra``'s)."""
+def arguments(doc: str | None, argv: Sequence[str] | None, *extra: tuple[str, dict[str, Any]],
+              quick: bool = True) -> argparse.Namespace:
+    """A benchmark's command line: ``--output``, ``--quick`` and ``extra`` (flag, options)."""
     parser = argparse.ArgumentParser(description=(doc or "").splitlines()[0])
-    parser.add_argument("--output", type=Path, default=Path(default_output),
-                        help=f"output folder (default: {default_output})")
-    parser.add_argument("--quick", action="store_true", help=quick)
-    if extra is not None:
-        extra(parser)
+    parser.add_argument("--output", type=Path, default=Path("benchmarks/results"),
+                        help="output folder (default: benchmarks/results)")
+    if quick:
+        parser.add_argument("--quick", action="store_true", help="small grids and budgets")
+    for flag, options in extra:
+        parser.add_argument(flag, **options)
     return parser.parse_args(argv)
 
 

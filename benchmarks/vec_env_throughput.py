@@ -7,7 +7,6 @@ steps per second, rollout and update time. Needs the ``rl`` extra.
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import time
@@ -18,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks import report
-from benchmarks.timing import Progress, machine_info
+from benchmarks.timing import Progress, arguments, machine_info
 
 BACKENDS = ("batched adapter", "DummyVecEnv", "SubprocVecEnv")
 """The vector envs compared, in the order they run."""
@@ -44,12 +43,7 @@ def make_backend(backend: str, env_id: str, num_envs: int, env_kwargs: dict[str,
 
 
 def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str, Any]:
-    """Train PPO for ``rollouts`` rollouts through ``backend``; times [s] and steps per second.
-
-    Returns:
-        {"backend", "setup_s", "train_s", "timesteps", "train_steps_per_s", "rollout_s",
-        "rollout_steps_per_s", "update_s"}.
-    """
+    """Train PPO for ``rollouts`` rollouts through ``backend``; times [s] and steps per second."""
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import BaseCallback
@@ -124,14 +118,11 @@ def plot(record: dict[str, Any], path: Path) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Measure every backend, write the JSON and PNG, print the table; returns 0."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.vec_env_throughput",
-                                     description=__doc__.split("\n")[0])  # fmt: skip
-    parser.add_argument("--env-id", default="mdi_envs/BlockableManipulator-v0")
-    parser.add_argument("--num-envs", type=int, default=64)
-    parser.add_argument("--rollouts", type=int, default=20, help="PPO rollouts per vector env")
-    parser.add_argument("--backends", nargs="+", choices=BACKENDS, default=list(BACKENDS))
-    parser.add_argument("--output", type=Path, default=Path("benchmarks/results"))
-    args = parser.parse_args(argv)
+    args = arguments(__doc__, argv, ("--env-id", {"default": "mdi_envs/BlockableManipulator-v0"}),
+                     ("--num-envs", {"type": int, "default": 64}),
+                     ("--rollouts", {"type": int, "default": 20, "help": "PPO rollouts each"}),
+                     ("--backends", {"nargs": "+", "choices": BACKENDS,
+                                     "default": list(BACKENDS)}), quick=False)
     say = Progress()
     record: dict[str, Any] = {"machine": machine_info(), "env_id": args.env_id,
                               "num_envs": args.num_envs, "rollouts": args.rollouts,

@@ -20,23 +20,17 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks import report
+from benchmarks import report, timing
 from benchmarks import work_precision_report as R
-from benchmarks.engine_mujoco import MujocoArm, import_mujoco
-from benchmarks.timing import (
-    VERSIONED_PACKAGES,
-    Progress,
-    TimingPlan,
-    arguments,
-    finish,
-    machine_info,
-)
-from benchmarks.work_precision_mujoco import (
+from benchmarks.engine_mujoco import (
+    MujocoArm,
     MujocoArmRun,
     MujocoBall,
     calibrate_dampratio,
     formula_dampratio,
+    import_mujoco,
 )
+from benchmarks.timing import Progress, TimingPlan
 from mdi_envs.mechanics.models import (
     BlockableManipulator,
     BouncingBall,
@@ -61,54 +55,21 @@ from mdi_envs.stepping.event_driven import EVENT_APEX, EVENT_IMPACT, Trajectory
 Log = Callable[[str], None]
 
 METHODS = {"enumerative": StepShortcuts(), "lemke": StepShortcuts(direct_solve_max_size=0)}
-"""The step's complementarity methods: exact enumeration for LCPs of <= 3 variables (default)
-or Lemke's method for every LCP."""
-
-ATOL_PER_RTOL = 1e-2
-"""Event-driven runs use atol = ATOL_PER_RTOL * rtol (in the units of q and u)."""
-
-BOUNCES = 3
-"""Apexes compared on the ball (impacts 2 .. BOUNCES + 1 for the times)."""
-
-# Manipulator scenario (tests/stepping/test_event_driven.py): the paper's brake schedule and a
-# torque reversal, all switch times multiples of SAMPLE_INTERVAL.
-ENGAGE_TIMES = (0.0, 1.072, 2.392)  # [s]
-RELEASE_TIMES = (0.412, 1.84)  # [s]
-TORQUE_SWITCH = 2.264  # [s]
-MANIPULATOR_HORIZON = 4.528  # [s]
-MAX_TORQUE = 1.0  # [N m]
-SAMPLE_INTERVAL = 4e-3  # [s] manipulator error sample times
-REFERENCE_RTOL, REFERENCE_ATOL = 1e-12, 1e-14
-CHECK_RTOL, CHECK_ATOL = 1e-11, 1e-13
-
-DIFF_DRIVE_PHASES = ((0.5, (1.0, 0.6)), (0.5, (3.0, -3.0)), (0.5, (-0.5, -0.5)))
-"""(duration [s], (tau_L, tau_R) [N m]) of the robot's phases."""
-
-SLOPE_STICKING_FRICTION = 0.6
-"""mu of the ``sticking`` case (> tan 0.5 = 0.546)."""
-STICK_SLIP = {"slope_angle": 0.3, "friction_coefficient": 0.5, "mass": 2.0, "rate": 8.0}
-"""The ``stick_slip`` case: slope [rad], mu, mass [kg] and push rate [N/s] (down-slope)."""
+ATOL_PER_RTOL = 1e-2  # event-driven runs: atol = ATOL_PER_RTOL * rtol
+BOUNCES = 3  # ball apexes compared (impacts 2 .. BOUNCES + 1 for the times)
+# The manipulator's scenario [s, N m]: the paper's brake schedule and a torque reversal.
+ENGAGE_TIMES, RELEASE_TIMES, TORQUE_SWITCH = (0.0, 1.072, 2.392), (0.412, 1.84), 2.264
+MANIPULATOR_HORIZON, MAX_TORQUE, SAMPLE_INTERVAL = 4.528, 1.0, 4e-3
+REFERENCE_RTOL, REFERENCE_ATOL, CHECK_RTOL, CHECK_ATOL = 1e-12, 1e-14, 1e-11, 1e-13
+DIFF_DRIVE_PHASES = ((0.5, (1.0, 0.6)), (0.5, (3.0, -3.0)), (0.5, (-0.5, -0.5)))  # [s], [N m]
+SLOPE_STICKING_FRICTION = 0.6  # > tan 0.5
+STICK_SLIP = {"slope_angle": 0.3, "friction_coefficient": 0.5, "mass": 2.0, "rate": 8.0}  # N/s
+TARGET_APEX_ERROR, TARGET_ORDER, TARGET_RATIO = 1e-3, 0.8, 100.0  # at dt = 1e-3 s; MuJoCo / ours
 
 
 @dataclass(frozen=True)
 class WorkPrecisionConfig:
-    """Scenes, grids and timing of one run.
-
-    Attributes:
-        scenes: which of ``ball``, ``slope``, ``manipulator``, ``diff_drive`` to run.
-        methods: Moreau-Jean complementarity methods (keys of ``METHODS``).
-        ball_time_steps, slope_time_steps, manipulator_time_steps, diff_drive_time_steps: dt
-            grids [s] (manipulator: divisors of 4 ms).
-        ball_drops: D, drops of the ball ensemble.
-        tolerances: event-driven rtol values.
-        mujoco_ball_time_steps: dt [s] of the MuJoCo ball (<= timeconst / 2 = 0.01 s).
-        mujoco_ball_series: ``formula`` and/or ``calibrated`` dampratio.
-        mujoco_arm_time_steps: dt [s] of the MuJoCo arm (divisors of 4 ms).
-        mujoco_arm_series: ``default`` and/or ``stiffest`` brake solref.
-        diff_drive_reference_step: dt_ref [s] of the robot's reference.
-        timing: repeats per point (min_rounds, max_rounds, budget_s; min_batch_s unused).
-        brake_stop: run ``benchmarks.engine.brake_stop_study`` (compiles ``step`` too).
-    """
+    """Scenes, methods, dt [s] and rtol grids, and the timing of one run."""
 
     scenes: tuple[str, ...]
     methods: tuple[str, ...]
@@ -117,56 +78,33 @@ class WorkPrecisionConfig:
     tolerances: tuple[float, ...]
     manipulator_time_steps: tuple[float, ...]
     mujoco_ball_time_steps: tuple[float, ...]
-    mujoco_ball_series: tuple[str, ...]
     mujoco_arm_time_steps: tuple[float, ...]
-    mujoco_arm_series: tuple[str, ...]
     timing: TimingPlan
     brake_stop: bool
+    mujoco_ball_series: tuple[str, ...] = ("formula", "calibrated")
+    mujoco_arm_series: tuple[str, ...] = ("default", "stiffest")
     slope_time_steps: tuple[float, ...] = ()
     diff_drive_time_steps: tuple[float, ...] = ()
     diff_drive_reference_step: float = 5e-6
 
 
 FULL = WorkPrecisionConfig(
-    scenes=("ball", "slope", "manipulator", "diff_drive"),
-    methods=("enumerative", "lemke"),
-    ball_time_steps=(1e-2, 4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 2e-5, 1e-5),
-    ball_drops=8,
+    scenes=("ball", "slope", "manipulator", "diff_drive"), methods=("enumerative", "lemke"),
+    ball_time_steps=(1e-2, 4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 2e-5, 1e-5), ball_drops=8,
     tolerances=(1e-4, 1e-6, 1e-8, 1e-10),
     manipulator_time_steps=(4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 2e-5, 1e-5),
     mujoco_ball_time_steps=(1e-2, 4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 1e-5),
-    mujoco_ball_series=("formula", "calibrated"),
     mujoco_arm_time_steps=(4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 1e-5),
-    mujoco_arm_series=("default", "stiffest"),
-    timing=TimingPlan(budget_s=0.5, min_rounds=3, max_rounds=15),
-    brake_stop=True,
+    timing=TimingPlan(budget_s=0.5, min_rounds=3, max_rounds=15), brake_stop=True,
     slope_time_steps=(1e-2, 4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 1e-5),
-    diff_drive_time_steps=(1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4),
-)
+    diff_drive_time_steps=(1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4))
 QUICK = WorkPrecisionConfig(
-    scenes=("ball", "manipulator"),
-    methods=("enumerative",),
-    ball_time_steps=(4e-3, 2e-3, 1e-3),
-    ball_drops=8,
-    tolerances=(1e-8,),
-    manipulator_time_steps=(4e-3, 2e-3, 1e-3),
-    mujoco_ball_time_steps=(2e-3, 1e-3, 1e-4),
-    mujoco_ball_series=("formula", "calibrated"),
-    mujoco_arm_time_steps=(2e-3, 1e-3),
-    mujoco_arm_series=("default", "stiffest"),
-    timing=TimingPlan(budget_s=0.0, min_rounds=3, max_rounds=3),
-    brake_stop=False,
-)
-
-TARGET_APEX_ERROR = 1e-3
-"""Relative ball apex error allowed at dt = 1e-3 s."""
-TARGET_ORDER = 0.8
-"""Smallest fitted convergence order of the ball error accepted as O(dt)."""
-TARGET_RATIO = 100.0
-"""MuJoCo's ball error / ours at equal wall time, at least."""
+    scenes=("ball", "manipulator"), methods=("enumerative",), ball_time_steps=(4e-3, 2e-3, 1e-3),
+    ball_drops=8, tolerances=(1e-8,), manipulator_time_steps=(4e-3, 2e-3, 1e-3),
+    mujoco_ball_time_steps=(2e-3, 1e-3, 1e-4), mujoco_arm_time_steps=(2e-3, 1e-3),
+    timing=TimingPlan(budget_s=0.0, min_rounds=3, max_rounds=3), brake_stop=False)
 
 
-# ----------------------------------------------------------------------------- shared helpers
 @dataclass
 class Context:
     """What every study needs: configuration, progress, MuJoCo, compile records, notes."""
@@ -204,15 +142,7 @@ class Context:
 
 def wall_time(call: Callable[[], Any], min_repeats: int, budget_s: float, max_repeats: int
               ) -> tuple[float, int, Any]:  # fmt: skip
-    """Best wall time of ``call()`` (``timeit.Timer.repeat``, one call per repeat, GC on).
-
-    One untimed warm-up call first; then as many timed calls as fit in ``budget_s`` [s] by the
-    warm-up's duration, at least ``min_repeats`` and at most ``max_repeats``.
-
-    Returns:
-        (best seconds, timed repeats, the warm-up call's return value: every call here restarts
-        from the same state, so all return the same).
-    """
+    """Best wall time of ``call()`` (``timeit.Timer.repeat``, one call per repeat, GC on)."""
     start = time.perf_counter()
     result = call()
     first = time.perf_counter() - start
@@ -222,11 +152,7 @@ def wall_time(call: Callable[[], Any], min_repeats: int, budget_s: float, max_re
 
 
 class Copies:
-    """N copies of one stepper's state with preallocated ``step_batch`` arguments.
-
-    Args:
-        stepper: the stepper. q0, u0: (N, n) initial states (copied).
-    """
+    """N copies of one stepper's state with preallocated ``step_batch`` arguments."""
 
     def __init__(self, stepper: MoreauJeanStepper, q0: np.ndarray, u0: np.ndarray) -> None:
         self.stepper = stepper
@@ -259,12 +185,7 @@ class Copies:
         return np.concatenate([self.q[copy], self.u[copy]])
 
     def run(self, phases: Sequence[tuple[int, Sequence[float], Sequence[float]]]) -> np.ndarray:
-        """From the initial states through (steps, inputs, brake bounds) phases, one call each.
-
-        Returns:
-            Copy 0's final ``state()``; ``worst_status`` holds the worst ``SolverStatus`` code
-            of copy 0 over the phases.
-        """
+        """From the initial states through (steps, inputs, brake bounds) phases, one call each."""
         self.reset()
         self.worst_status = 0
         for steps, tau, brake in phases:
@@ -274,25 +195,19 @@ class Copies:
         return self.state()
 
 
-def point(scene: str, series: str, parameter: str, value: float, wall_s: float, repeats: int,
-          path: str, errors: dict[str, Any], **extra: Any) -> dict[str, Any]:
-    """One work-precision point (NaN errors become None and mark the point failed)."""
+def point(log: Log, scene: str, series: str, parameter: str, value: float, wall_s: float | None,
+          repeats: int, path: str, errors: dict[str, Any], **extra: Any) -> dict[str, Any]:
+    """One work-precision point, logged (NaN errors become None and mark the point failed)."""
     clean = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
              for k, v in errors.items()}
     status = (extra.pop("status", None) or clean.pop("status", None)
               or ("ok" if clean.get("error") is not None else "failed: no error measured"))
-    return {"scene": scene, "series": series, "parameter": parameter, "value": value,
-            "wall_time_s": wall_s, "repeats": repeats, "timed_path": path, **clean,
-            "status": status, **extra}
-
-
-def failed_point(scene: str, series: str, parameter: str, value: float, reason: str
-                 ) -> dict[str, Any]:
-    """A point whose run failed: no time (None), no error."""
-    failed = point(scene, series, parameter, value, math.nan, 0, "", {"error": math.nan},
-                   status=f"failed: {reason}")
-    failed["wall_time_s"] = None
-    return failed
+    p = {"scene": scene, "series": series, "parameter": parameter, "value": value,
+         "wall_time_s": wall_s, "repeats": repeats, "timed_path": path, **clean,
+         "status": status, **extra}
+    error = "failed" if p.get("error") is None else f"error {p['error']:.3e}"
+    log(f"  {scene} {series} {parameter} = {value:g}: {error}, {wall_s} s ({status})")
+    return p
 
 
 def _steps(duration: float, dt: float) -> int:
@@ -303,15 +218,6 @@ def _steps(duration: float, dt: float) -> int:
     return steps
 
 
-def _log_point(log: Log, p: dict[str, Any]) -> None:
-    error = p.get("error")
-    text = "failed" if error is None else f"error {error:.3e}"
-    wall = "" if p["wall_time_s"] is None else f", {p['wall_time_s'] * 1e3:.3g} ms"
-    log(f"  {p['scene']} {p['series']} {p['parameter']} = {p['value']:g}: {text}{wall} "
-        f"({p['status']})")
-
-
-# ---------------------------------------------------------------------------------------- ball
 def drop_gaps(count: int) -> np.ndarray:
     """The ball ensemble's initial gaps h0 [m], (count,), U(0.9, 1.1) with seed 0."""
     return np.random.default_rng(0).uniform(0.9, 1.1, count)
@@ -326,11 +232,7 @@ def ball_closed_form(p: BouncingBallParameters, gap: float) -> tuple[np.ndarray,
 
 
 def ball_horizon(p: BouncingBallParameters, gaps: np.ndarray) -> float:
-    """[s] 1.25 times the last compared impact of the highest drop (before the Zeno point).
-
-    The margin lets a simulator whose bounces run slow (MuJoCo's soft contacts) still show
-    its third apex.
-    """
+    """[s] 1.25 times the last compared impact of the highest drop (before the Zeno point)."""
     return 1.25 * float(ball_closed_form(p, float(gaps.max()))[1][-1])
 
 
@@ -362,16 +264,11 @@ def _ball_summary(per_drop: list[tuple[np.ndarray, float] | str]) -> dict[str, A
 
 def ball_errors(p: BouncingBallParameters, gaps: np.ndarray, y: np.ndarray, v: np.ndarray,
                 dt: float) -> dict[str, Any]:
-    """Errors of sampled drops (see the module docstring).
+    """Errors of sampled drops: y, v (D, K + 1) heights [m] and velocities [m/s] every dt [s].
 
-    Args:
-        p: ball parameters. gaps: (D,) initial gaps [m].
-        y: (D, K + 1) heights of the centre at t = 0, dt, ... [m]. v: (D, K + 1) y' [m/s].
-        dt: sample spacing [s].
-
-    Returns:
-        ``error`` (mean over drops of the largest relative apex error), ``error_max``,
-        ``apex_error_by_bounce`` (mean per bounce), ``impact_time_error_s``, ``failed_drops``.
+    ``error``: the mean over drops of the largest relative apex error over bounces 1-3 (apex: the
+    largest sample at a + to - sign change of y'); ``impact_time_error_s`` from the landing times
+    of the simulated flights; ``error_max``, ``apex_error_by_bounce``, ``failed_drops``.
     """
     per_drop: list[tuple[np.ndarray, float] | str] = []
     g, r = p.gravity, p.radius
@@ -410,11 +307,7 @@ def _ball_initial(p: BouncingBallParameters, gaps: np.ndarray) -> tuple[np.ndarr
 
 
 def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
-    """Moreau-Jean ball points: per method and dt, drop 0 timed, D drops replayed step by step.
-
-    Series ``mj_<method>`` (the midpoint step) and ``mj_located`` (enumerative LCP with
-    ``locate_impacts=True``: each impact step split at the impact time).
-    """
+    """Moreau-Jean ball points: per method and dt, drop 0 timed, D drops replayed step by step."""
     p, config = BouncingBallParameters(), ctx.config
     gaps = drop_gaps(config.ball_drops)
     horizon = ball_horizon(p, gaps)
@@ -433,11 +326,9 @@ def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
             for k in range(1, num_steps + 1):
                 replay.advance(1)
                 y[:, k], v[:, k] = replay.q[:, 1], replay.u[:, 1]
-            points.append(point(
-                "ball", series, "dt", dt, wall, repeats, "mj_one_call",
-                ball_errors(p, gaps, y, v, dt),
-                replay_difference=float(np.abs(replay.state() - final).max())))
-            _log_point(ctx.log, points[-1])
+            points.append(point(ctx.log, "ball", series, "dt", dt, wall, repeats, "mj_one_call",
+                                ball_errors(p, gaps, y, v, dt),
+                                replay_difference=float(np.abs(replay.state() - final).max())))
     return points
 
 
@@ -449,16 +340,12 @@ def ball_event_driven(ctx: Context) -> list[dict[str, Any]]:
     points = []
     for rtol in config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
-
-        def run(options: dict[str, float] = options) -> Trajectory:
-            return simulate_ball(p, p.radius + gaps[0], horizon, **options)
-
-        wall, repeats, _ = ctx.timed(run)
+        wall, repeats, _ = ctx.timed(partial(simulate_ball, p, p.radius + gaps[0], horizon,
+                                             **options))
         runs = [simulate_ball(p, p.radius + gap, horizon, **options) for gap in gaps]
-        points.append(point("ball", "event_driven", "rtol", rtol, wall, repeats, "ed",
+        points.append(point(ctx.log, "ball", "event_driven", "rtol", rtol, wall, repeats, "ed",
                             ball_event_errors(p, gaps, runs), atol=options["atol"],
                             rhs_evaluations=runs[0].num_rhs_evals))
-        _log_point(ctx.log, points[-1])
     return points
 
 
@@ -477,8 +364,8 @@ def ball_mujoco(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, Any]
             else:
                 dampratio, note = calibrate_dampratio(ctx.mujoco, p, dt)
             if dampratio is None:
-                points.append(failed_point("ball", name, "dt", dt, note))
-                ctx.log(f"  ball {name} dt = {dt:g}: {note}")
+                points.append(point(ctx.log, "ball", name, "dt", dt, None, 0, "",
+                                    {"error": math.nan}, status=f"failed: {note}"))
                 continue
             ball = MujocoBall(ctx.mujoco, p, dt, dampratio)
             restitution = ball.effective_restitution()
@@ -486,33 +373,22 @@ def ball_mujoco(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, Any]
                                  "effective_restitution": restitution, "note": note,
                                  **ball.contact_settings})
             num_steps = math.ceil(horizon / dt)
-
-            def drop(ball: MujocoBall = ball, num_steps: int = num_steps) -> tuple[float, float]:
-                return ball.run(float(gaps[0]), num_steps)
-
-            wall, repeats, final = ctx.timed(drop)
+            wall, repeats, final = ctx.timed(partial(ball.run, float(gaps[0]), num_steps))
             y, v = ball.trajectories(gaps, num_steps)
             difference = max(abs(y[0, -1] - final[0]), abs(v[0, -1] - final[1]))
             points.append(point(
-                "ball", name, "dt", dt, wall, repeats, "mujoco_one_call",
+                ctx.log, "ball", name, "dt", dt, wall, repeats, "mujoco_one_call",
                 ball_errors(p, gaps, y, v, dt), replay_difference=float(difference),
                 dampratio=dampratio, effective_restitution=restitution))
-            _log_point(ctx.log, points[-1])
     return points, calibrations
 
 
-# --------------------------------------------------------------------------------------- slope
 def stick_slip_closed_form(theta: float, mu: float, mass: float, rate: float, gravity: float
                            ) -> tuple[float, float, Callable[[float], float],
                                       Callable[[float], float]]:
-    """The down-slope triangular push: stick, slide, stick (tests/stepping/...block.py).
+    """(t_s [s], final s [m], push(t) [N], s'(t) [m/s]) of the triangular push: stick, slide, stick.
 
-    The push rate * t rises to T1 = 1.5 t_b, then falls at the same rate; it exceeds the
-    breakaway force F = m g (mu cos theta - sin theta) from t_b = F / rate on; with
-    d = T1 - t_b the block stops at t_s = T1 + (1 + sqrt 2) d and sticks for good.
-
-    Returns:
-        (t_s [s], final position s [m], push(t) [N], speed(t) = s'(t) [m/s]).
+    The push ``rate * t`` rises to 1.5 t_b (t_b: breakaway), then falls at the same rate.
     """
     t_b = mass * gravity * (mu * math.cos(theta) - math.sin(theta)) / rate
     t1 = 1.5 * t_b
@@ -543,7 +419,6 @@ def slope_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
         for case in ("sliding", "sticking", "stick_slip"):
             for dt in ctx.config.slope_time_steps:
                 points.append(_slope_point(ctx, method, case, dt))
-                _log_point(ctx.log, points[-1])
     return points
 
 
@@ -560,7 +435,7 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
         wall, repeats, final = ctx.timed(partial(run.run, [(num_steps, (0.0,), ())]))
         exact = np.array([0.5 * a, 0.0, a, 0.0])  # (s, n, s', n') at T = 1 s
         errors = {"error": float(np.abs(final - exact).max())}
-        return point("slope", series, "dt", dt, wall, repeats, "mj_one_call", errors)
+        return point(ctx.log, "slope", series, "dt", dt, wall, repeats, "mj_one_call", errors)
     p = SlidingBlockParameters(**{k: v for k, v in STICK_SLIP.items() if k != "rate"})
     t_s, s_final, push, speed = stick_slip_closed_form(
         p.slope_angle, p.friction_coefficient, p.mass, STICK_SLIP["rate"], p.gravity)
@@ -581,12 +456,11 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
     exact_speeds = np.array([speed((k + 1) * dt) for k in range(num_steps)])
     speed_error = float(np.abs(speeds - exact_speeds).max())
     final_error = float(max(abs(final[0] - s_final), np.abs(final[1:]).max()))
-    return point("slope", series, "dt", dt, wall, repeats, "mj_per_step",
+    return point(ctx.log, "slope", series, "dt", dt, wall, repeats, "mj_per_step",
                  {"error": max(speed_error, final_error), "final_error": final_error,
                   "speed_error": speed_error})
 
 
-# --------------------------------------------------------------------------------- manipulator
 def manipulator_schedule() -> tuple[PiecewiseConstant, PiecewiseConstant, list[float]]:
     """(torque tau(t) [N m], brake bound a(t), phase boundaries [s] from 0 to the horizon)."""
     torque = bang_bang(MAX_TORQUE, [TORQUE_SWITCH])
@@ -647,10 +521,9 @@ def manipulator_moreau_jean(ctx: Context, reference: np.ndarray) -> list[dict[st
                 run.advance(stride)
                 samples.append(run.state())
         points.append(point(
-            "manipulator", "mj_enumerative", "dt", dt, wall, repeats, "mj_per_phase",
+            ctx.log, "manipulator", "mj_enumerative", "dt", dt, wall, repeats, "mj_per_phase",
             _state_errors(np.array(samples), reference),
             replay_difference=float(np.abs(samples[-1] - final).max())))
-        _log_point(ctx.log, points[-1])
     return points
 
 
@@ -661,16 +534,12 @@ def manipulator_event_driven(ctx: Context, reference: np.ndarray) -> list[dict[s
     points = []
     for rtol in ctx.config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
-
-        def run(options: dict[str, float] = options) -> Trajectory:
-            return simulate_manipulator(None, [0.0, 0.0], [0.0, 0.0], torque, brake,
-                                        MANIPULATOR_HORIZON, sample_times=grid, **options)
-
-        wall, repeats, trajectory = ctx.timed(run)
-        points.append(point("manipulator", "event_driven", "rtol", rtol, wall, repeats, "ed",
-                            _state_errors(np.hstack([trajectory.q, trajectory.u]), reference),
+        wall, repeats, trajectory = ctx.timed(partial(
+            simulate_manipulator, None, [0.0, 0.0], [0.0, 0.0], torque, brake,
+            MANIPULATOR_HORIZON, sample_times=grid, **options))
+        points.append(point(ctx.log, "manipulator", "event_driven", "rtol", rtol, wall, repeats,
+                            "ed", _state_errors(np.hstack([trajectory.q, trajectory.u]), reference),
                             atol=options["atol"], rhs_evaluations=trajectory.num_rhs_evals))
-        _log_point(ctx.log, points[-1])
     return points
 
 
@@ -683,30 +552,18 @@ def manipulator_mujoco(ctx: Context, reference: np.ndarray) -> list[dict[str, An
             arm = MujocoArmRun(ctx.mujoco, dt, solref)
             phases = [(steps, torque, bool(np.isinf(bound)))
                       for steps, torque, bound in manipulator_phases(dt)]
-
-            def timed(arm: MujocoArmRun = arm, phases: list = phases
-                      ) -> tuple[np.ndarray, np.ndarray | None]:
-                return arm.simulate(phases)
-
-            wall, repeats, (final, _) = ctx.timed(timed)
+            wall, repeats, (final, _) = ctx.timed(partial(arm.simulate, phases))
             _, samples = arm.simulate(phases, _steps(SAMPLE_INTERVAL, dt))
             assert samples is not None
             points.append(point(
-                "manipulator", f"mujoco_{series}", "dt", dt, wall, repeats, "mujoco_per_phase",
-                _state_errors(samples, reference),
-                replay_difference=float(np.abs(samples[-1] - final).max()),
-                **arm.brake_settings))
-            _log_point(ctx.log, points[-1])
+                ctx.log, "manipulator", f"mujoco_{series}", "dt", dt, wall, repeats,
+                "mujoco_per_phase", _state_errors(samples, reference),
+                replay_difference=float(np.abs(samples[-1] - final).max()), **arm.brake_settings))
     return points
 
 
-# ---------------------------------------------------------------------------------- diff-drive
 def diff_drive_run(ctx: Context, dt: float) -> tuple[Callable[[], np.ndarray], Copies]:
-    """A zero-argument run of the robot's phases at dt (one call per phase), and its copies.
-
-    The run returns the final state (10,); the copies' ``worst_status`` is the worst
-    ``SolverStatus`` code over its steps.
-    """
+    """A zero-argument run of the robot's phases at dt (one call per phase), and its copies."""
     run = Copies(ctx.stepper(DiffDriveRobot, None, dt), np.zeros((1, 5)), np.zeros((1, 5)))
     return partial(run.run, [(_steps(duration, dt), tau, ())
                              for duration, tau in DIFF_DRIVE_PHASES]), run
@@ -730,14 +587,12 @@ def diff_drive_moreau_jean(ctx: Context) -> tuple[list[dict[str, Any]], dict[str
     for dt in ctx.config.diff_drive_time_steps:
         call, copies = diff_drive_run(ctx, dt)
         wall, repeats, final = ctx.timed(call)
-        points.append(point("diff_drive", "mj_newton_ac", "dt", dt, wall, repeats,
+        points.append(point(ctx.log, "diff_drive", "mj_newton_ac", "dt", dt, wall, repeats,
                             "mj_per_phase", {"error": float(np.abs(final - reference).max())},
                             worst_solver_status=SolverStatus(copies.worst_status).name))
-        _log_point(ctx.log, points[-1])
     return points, record
 
 
-# ------------------------------------------------------------------------------------- targets
 def observed_order(points: Sequence[dict[str, Any]]) -> float | None:
     """Least-squares slope of log(error) against log(dt) (None with fewer than 2 points)."""
     usable = [(p["value"], p["error"]) for p in points if p.get("error")]
@@ -796,7 +651,6 @@ def evaluate_targets(points: Sequence[dict[str, Any]], brake: dict[str, Any] | N
     return targets, comparison
 
 
-# ----------------------------------------------------------------------------------------- run
 def _section(ctx: Context, name: str, action: Callable[[], Any], fallback: Any) -> Any:
     """Run one study; on an exception note it (``main`` then exits with 1) and go on."""
     try:
@@ -812,17 +666,7 @@ def _section(ctx: Context, name: str, action: Callable[[], Any], fallback: Any) 
 
 def run(output: Path, quick: bool, log: Log | None = None,
         config: WorkPrecisionConfig | None = None) -> dict[str, Any]:
-    """Run the benchmark, write the JSON and plots to ``output`` and return the record.
-
-    Args:
-        output: folder for ``work_precision.json`` and the PNGs (created).
-        quick: use ``QUICK`` (ball + manipulator, 3 dt each) instead of ``FULL``.
-        log: progress sink (default: stamped lines on stderr).
-        config: overrides the configuration chosen by ``quick``.
-
-    Returns:
-        The record written to ``work_precision.json``.
-    """
+    """Run the benchmark, write the JSON and plots to ``output`` and return the record."""
     progress = Progress()
     log = log or progress
     config = config or (QUICK if quick else FULL)
@@ -832,7 +676,7 @@ def run(output: Path, quick: bool, log: Log | None = None,
     if mujoco_note:
         ctx.notes.append(mujoco_note)
     record: dict[str, Any] = {
-        "machine": machine_info((*VERSIONED_PACKAGES, "mujoco")),
+        "machine": timing.machine_info((*timing.VERSIONED_PACKAGES, "mujoco")),
         "config": {"quick": quick, **asdict(config)},
         "timed_paths": R.TIMED_PATHS,
     }
@@ -871,7 +715,7 @@ def run(output: Path, quick: bool, log: Log | None = None,
                    "mujoco_ball_calibration": calibrations, "brake_stop": brake,
                    "equal_time": comparison, "targets": targets, "notes": ctx.notes,
                    "failed_sections": ctx.failed_sections})
-    finish(record, progress.elapsed)
+    timing.finish(record, progress.elapsed)
     scenes = [s for s in config.scenes if any(p["scene"] == s for p in points)]
     record["plots"] = R.plot_all(points, scenes, output)
     record = report.json_safe(record)
@@ -896,14 +740,8 @@ def _brake_stop(ctx: Context) -> dict[str, Any]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command-line entry point.
-
-    Returns:
-        0 when every study ran (missed targets are reported, not enforced); 1 when a study
-        raised (its error is in the notes; the other studies' results are still written).
-        A crash outside the studies propagates (Python exits with 1).
-    """
-    args = arguments(__doc__, argv, "ball and manipulator only, 3 time steps, one tolerance")
+    """Command-line entry point."""
+    args = timing.arguments(__doc__, argv)
     record = run(args.output, args.quick)
     print(R.markdown_report(record))
     return 1 if record.get("failed_sections") else 0

@@ -12,11 +12,9 @@ import numpy as np
 
 from benchmarks.engine_report import brake_rows
 from benchmarks.report import format_number as _format
-from benchmarks.report import plt, save_figure, summary
+from benchmarks.report import log_lines, plt, save_figure, summary
 
-ERROR_FLOOR = 1e-17
-"""Exactly-zero errors are drawn at this value on log axes."""
-
+ERROR_FLOOR = 1e-17  # exactly-zero errors are drawn at or below this on log axes
 TIMED_PATHS = {
     "mj_one_call": "one step_batch call (N = 1, check_inputs=False, num_substeps = all steps)",
     "mj_per_phase": "one step_batch call (N = 1, check_inputs=False) per constant-command phase",
@@ -48,14 +46,6 @@ SCENE_TITLES = {
     "diff_drive": "Diff-drive robot: |final state − Moreau–Jean at dt_ref| [m, rad, m/s, rad/s]",
 }
 
-_CASE_COLORS = {"sliding": "tab:blue", "sticking": "tab:green", "stick_slip": "tab:red"}
-_SERIES_COLORS = {"mj_enumerative": "tab:blue", "mj_lemke": "tab:cyan",
-                  "mj_located": "tab:purple",
-                  "mj_newton_ac": "tab:blue", "event_driven": "tab:green",
-                  "mujoco_formula": "tab:orange", "mujoco_calibrated": "tab:red",
-                  "mujoco_default": "tab:orange", "mujoco_stiffest": "tab:red"}
-
-
 def series_title(series: str) -> str:
     """Readable series name (slope series are ``method:case``)."""
     method, _, case = series.partition(":")
@@ -63,7 +53,6 @@ def series_title(series: str) -> str:
     return f"{title} · {case}" if case else title
 
 
-# ---------------------------------------------------------------------- equal-time comparison
 def pareto_front(points: Sequence[Mapping[str, Any]]) -> list[tuple[float, float, str]]:
     """(wall time [s], error, label) of the points no other point beats in both, by time."""
     usable = sorted((p["wall_time_s"], p["error"], f"{p['series']} dt={p['value']:g}")
@@ -92,22 +81,13 @@ def interpolate_front(front: Sequence[tuple[float, float, str]], seconds: float
 
 def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
                           mujoco: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
-    """MuJoCo's ball error divided by ours at our wall times.
+    """MuJoCo's ball error / ours at our wall times, off MuJoCo's Pareto front.
 
-    MuJoCo's points (all its series pooled, failed runs left out) are reduced to their Pareto
-    front: sorted by wall time, each point kept if its error is below every faster point's
-    (what a user choosing the best MuJoCo setting for a time budget gets). At each of our wall
-    times t, MuJoCo's error is interpolated linearly in (log t, log error) between the two
-    front points around t ("interpolated": an equal-time ratio). Where our run is faster than
-    MuJoCo's fastest front point, that point's error is used ("clamped": MuJoCo is given more
-    time than ours, so the ratio is a lower bound); where ours is slower than MuJoCo's slowest
-    point, nothing is compared ("beyond").
-
-    Returns:
-        ``rows`` (per our point: dt, wall time, our error, MuJoCo's, how, ratio), ``min_ratio``
-        and ``max_ratio`` (over every compared point), ``min_equal_time_ratio`` (interpolated
-        points), ``min_lower_bound_ratio`` (clamped points), ``ratio_at_1ms`` (None when not
-        compared), ``front`` and ``summary``.
+    Between front points the error is interpolated in (log t, log error) ("interpolated"); where
+    ours is faster than the fastest front point that point's error is used ("clamped": a lower
+    bound); beyond the slowest nothing is compared ("beyond"). Returns ``rows``, ``front``,
+    ``min_ratio``, ``max_ratio``, ``min_equal_time_ratio``, ``min_lower_bound_ratio``,
+    ``ratio_at_1ms`` and ``summary``.
     """
     front = pareto_front(mujoco)
     rows = []
@@ -162,50 +142,23 @@ def markdown_report(record: Mapping[str, Any]) -> str:
     })
 
 
-# ------------------------------------------------------------------------------------- plots
-def _zero_floor(points: Sequence[Mapping[str, Any]]) -> float:
-    """Where errors of exactly 0 are drawn: a decade below the smallest positive error."""
-    positive = [p["error"] for p in points if p.get("error")]
-    return min(ERROR_FLOOR, 0.1 * min(positive)) if positive else ERROR_FLOOR
-
-
-def _style(series: str) -> dict[str, Any]:
-    method, _, case = series.partition(":")
-    if case:
-        return {"color": _CASE_COLORS.get(case, "k"),
-                "ls": "-" if method == "mj_enumerative" else "--",
-                "marker": "o" if method == "mj_enumerative" else "x", "ms": 5}
-    if method == "mj_lemke":  # drawn over the default method's line, which it often equals
-        return {"color": _SERIES_COLORS[method], "ls": "--", "marker": "x", "ms": 6}
-    marker = "o" if method.startswith("mj") else ("^" if method == "event_driven" else "s")
-    return {"color": _SERIES_COLORS.get(method, "k"), "ls": "-", "marker": marker, "ms": 5}
-
-
 def plot_scene(points: Sequence[Mapping[str, Any]], scene: str, path: Path) -> None:
     """Log-log error against wall time, one line per series, each point labelled by dt/rtol."""
     fig, ax = plt.subplots(figsize=(8.0, 5.4))
-    floor = _zero_floor(points)
-    for series in dict.fromkeys(p["series"] for p in points):
-        chosen = sorted((p for p in points if p["series"] == series
-                         and p.get("error") is not None), key=lambda p: -p["value"])
-        if not chosen:
-            continue
-        x = np.array([p["wall_time_s"] * 1e3 for p in chosen])
-        y = np.array([p["error"] if p["error"] > 0.0 else floor for p in chosen])
-        ax.plot(x, y, label=series_title(series), lw=1.2, **_style(series))
-        for p, xi, yi in zip(chosen, x, y, strict=True):
-            ax.annotate(f"{p['value']:g}", (xi, yi), textcoords="offset points", xytext=(3, 3),
-                        fontsize=6, color=_style(series)["color"])
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+    positive = [p["error"] for p in points if p.get("error")]
+    floor = min(ERROR_FLOOR, 0.1 * min(positive)) if positive else ERROR_FLOOR
+    rows = [{**p, "ms": p["wall_time_s"] * 1e3, "drawn": max(p["error"], floor)}
+            for p in points if p.get("error") is not None]
+    log_lines(ax, rows, "ms", "drawn", "series", label=series_title,
+              dashed=lambda s: "lemke" in s, ticks=False)
+    for p in rows:
+        ax.annotate(f"{p['value']:g}", (p["ms"], p["drawn"]), textcoords="offset points",
+                    xytext=(3, 3), fontsize=6)
     ax.set_ylabel("error")
     ax.set_title(textwrap.fill(SCENE_TITLES.get(scene, scene), 95), fontsize=9)
-    ax.grid(True, which="both", lw=0.3, alpha=0.5)
     ax.legend(fontsize=7)
-    note = "wall time per trajectory [ms]   (point labels: dt [s] or rtol"
-    if any(p.get("error") == 0.0 for p in points):
-        note += f"; errors of exactly 0 drawn at {floor:.0e}"
-    ax.set_xlabel(note + ")")
+    ax.set_xlabel("wall time per trajectory [ms]   (point labels: dt [s] or rtol; errors of "
+                  f"exactly 0 drawn at {floor:.0e})")
     save_figure(fig, path)
 
 
@@ -213,10 +166,8 @@ def plot_ball_convergence(points: Sequence[Mapping[str, Any]], path: Path) -> No
     """Ball error against dt (log-log), with an O(dt) slope and the 1e-3 target marked."""
     fig, ax = plt.subplots(figsize=(7.0, 5.0))
     stepped = [p for p in points if p["parameter"] == "dt" and p.get("error") is not None]
-    for series in dict.fromkeys(p["series"] for p in stepped):
-        chosen = sorted((p for p in stepped if p["series"] == series), key=lambda p: p["value"])
-        ax.plot([p["value"] for p in chosen], [p["error"] for p in chosen],
-                label=series_title(series), lw=1.2, **_style(series))
+    log_lines(ax, stepped, "value", "error", "series", label=series_title,
+              dashed=lambda s: "lemke" in s, ticks=False)
     ours = sorted((p for p in stepped if p["series"] == "mj_enumerative"),
                   key=lambda p: p["value"])
     if ours:
@@ -226,12 +177,9 @@ def plot_ball_convergence(points: Sequence[Mapping[str, Any]], path: Path) -> No
                 label="O(dt) reference slope")
     ax.plot([1e-3], [1e-3], marker="*", color="k", ms=10, ls="none",
             label="target: 1e-3 at dt = 1e-3 s")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
     ax.set_xlabel("time step dt [s]")
     ax.set_ylabel("mean largest relative apex error, bounces 1–3")
     ax.set_title("Bouncing ball: convergence in dt", fontsize=9)
-    ax.grid(True, which="both", lw=0.3, alpha=0.5)
     ax.legend(fontsize=7)
     save_figure(fig, path)
 
