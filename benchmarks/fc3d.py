@@ -74,28 +74,17 @@ def run(output: Path, quick: bool) -> str:
         for method, options in METHODS.items():
             result, seconds = time_solve(data, method, options)
             residual = float(fc3d_residual(data.W, data.q, data.mu, result.r))
-            row[method] = {
-                "time_s": seconds,
-                "residual": residual,
-                "status": result.status.name,
-                "iterations": int(result.num_iter),
-                "converged": result.status is SolverStatus.CONVERGED,
-            }
+            row[method] = {"time_s": seconds, "residual": residual, "status": result.status.name,
+                           "iterations": int(result.num_iter),
+                           "converged": result.status is SolverStatus.CONVERGED}
         row["solved"] = any(row[m]["converged"] for m in METHODS)
         rows.append(row)
-        log(f"{path.stem} (n={n}): " + ", ".join(
-            f"{m} {row[m]['status']} {row[m]['residual']:.1e} in {row[m]['time_s']:.3g} s"
-            for m in METHODS
-        ))
+        log(f"{path.stem} (n={n}): " + ", ".join(f"{m} {row[m]['status']}" for m in METHODS))
     solved = {m: sum(r[m]["converged"] for r in rows) for m in METHODS}
-    record = {
-        "machine": {**machine_info(), "load_average_at_end": load_average()},
-        "config": {"quick": quick, "tol": TOL, "methods": METHODS},
-        "problems": rows,
-        "solved_by_method": solved,
-        "solved_by_any": sum(r["solved"] for r in rows),
-        "run_time_s": log.elapsed,
-    }
+    record = {"machine": {**machine_info(), "load_average_at_end": load_average()},
+              "config": {"quick": quick, "tol": TOL, "methods": METHODS}, "problems": rows,
+              "solved_by_method": solved, "solved_by_any": sum(r["solved"] for r in rows),
+              "run_time_s": log.elapsed}
     report.write_json(record, output / "fc3d.json")
     if not rows:  # no peer data here: nothing to draw (a log axis of no values fails)
         log(f"done in {log.elapsed:.0f} s; wrote fc3d.json (no problems) to {output}")
@@ -106,23 +95,12 @@ def run(output: Path, quick: bool) -> str:
 
 
 def markdown(record: dict[str, Any]) -> str:
-    """The per-problem table and the counts."""
-    header = ["problem", "n"] + [f"{m} s · residual · status (iter)" for m in METHODS]
-    body = [
-        [row["name"], str(row["n"])] + [
-            f"{row[m]['time_s']:.3g} · {row[m]['residual']:.1e} · "
-            f"{'**' + row[m]['status'] + '**' if row[m]['converged'] else row[m]['status']} "
-            f"({row[m]['iterations']})"
-            for m in METHODS
-        ]
-        for row in record["problems"]
-    ]
-    counts = ", ".join(f"{m} {c}" for m, c in record["solved_by_method"].items())
-    return (
-        report.markdown_table(body, header)
-        + f"\n\nConverged to {TOL:g}: {counts}; by at least one method "
-        f"{record['solved_by_any']} of {len(record['problems'])}."
-    )
+    """The run line, per problem each method's time, residual and status, and the counts."""
+    return report.summary(record, ("numpy", "numba", "scipy"), {
+        f"FC3D per problem, tol {TOL:g}": (record["problems"], ["name", "n", *(
+            f"{m}.{k}" for m in METHODS for k in ("time_s", "residual", "status"))]),
+        "Problems converged": [{**record["solved_by_method"], "any": record["solved_by_any"],
+                                "of": len(record["problems"])}]})
 
 
 def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:

@@ -157,32 +157,14 @@ def _targets(record: dict[str, Any], env_ids: Sequence[str],
 
 
 def table(record: dict[str, Any]) -> str:
-    """The Markdown table of a ``startup.json`` record."""
+    """Markdown of a ``startup.json`` record: compile all, then per case warm, ratio and cold."""
+    rows = [{"case": key, "warm median [s]": warm.get("median"), "warm min [s]": warm.get("min"),
+             "/ Acrobot-v1": record["ratios_to_acrobot"].get(key),
+             "cold [s]": record["cold"].get(key, {}).get("median"),
+             "error": (warm.get("errors") or [""])[0]} for key, warm in record["warm"].items()]
     compiled = record["compile_all"]
-    lines = [f"`mdi-envs compile all`: {compiled['seconds']:.1f} s "
-             f"({'user cache' if record['quick'] else 'empty cache'}, exit "
-             f"{compiled['returncode']})"
-             + (f"; again on the warm cache {record['compile_all_warm']['seconds']:.1f} s"
-                if "compile_all_warm" in record else ""), "",
-             report.markdown_table(_table_rows(record))]
-    return "\n".join(lines)
-
-
-def _table_rows(record: dict[str, Any]) -> list[dict[str, str]]:
-    """One row per (env id, entry): warm median and min, ratio to Acrobot-v1, cold."""
-    rows = []
-    for key, summary in record["warm"].items():
-        env_id, entry = key.rsplit(" ", 1)
-        ratio = record["ratios_to_acrobot"].get(key)
-        cold = record["cold"].get(key, {}).get("median")
-        failed = " (failed: " + summary["errors"][0] + ")" if "errors" in summary else ""
-        rows.append({"env id": env_id, "entry": entry,
-                     "warm median [s]": f"{summary.get('median', float('nan')):.2f}{failed}",
-                     "warm min [s]": f"{summary.get('min', float('nan')):.2f}",
-                     f"/ Acrobot-v1 (target ≤ {record['target_ratio']:g})":
-                     "-" if ratio is None else f"{ratio:.2f}",
-                     "cold [s]": "-" if cold is None else f"{cold:.1f}"})
-    return rows
+    return (f"`mdi-envs compile all`: {compiled['seconds']:.1f} s (exit {compiled['returncode']},"
+            f" {'user' if record['quick'] else 'empty'} cache)\n\n" + report.flat_table(rows))
 
 
 def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],

@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 
 from benchmarks import work_precision as wp
-from benchmarks import work_precision_report as wpr
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
 
 
@@ -59,7 +58,7 @@ def test_outputs_exist_and_are_consistent(quick: tuple[Path, dict[str, Any]]) ->
             ("manipulator", "mj_enumerative"), ("manipulator", "event_driven")} <= series
     brake = [t for t in record["targets"] if t["target"].startswith("brake stops")]
     assert len(brake) == 1 and brake[0]["met"] is None  # no brake-stop study in --quick
-    report = wpr.markdown_report(record)
+    report = wp.markdown_report(record)
     header = next(line for line in report.splitlines() if line.startswith("| target "))
     assert "**Targets**" in report and header.split("|")[2].strip() == "threshold"
     assert "Bouncing ball" in report and "Manipulator" in report
@@ -186,10 +185,10 @@ def test_equal_time_comparison_interpolates_on_mujocos_front() -> None:
     mujoco = [pt("mujoco_a", 1e-3, 1e-3, 1e-1), pt("mujoco_a", 1e-4, 1e-1, 1e-2),
               pt("mujoco_b", 1e-3, 2e-3, 5e-1),  # dominated: slower and worse
               pt("mujoco_b", 1e-2, 1e-4, None)]  # failed run: ignored
-    front = wpr.pareto_front(mujoco)
+    front = wp.pareto_front(mujoco)
     assert [f[:2] for f in front] == [(1e-3, 1e-1), (1e-1, 1e-2)]
     ours = [pt("mj", 1e-2, 1e-4, 1e-3), pt("mj", 1e-3, 1e-2, 1e-4), pt("mj", 1e-5, 1.0, 1e-6)]
-    comparison = wpr.equal_time_comparison(ours, mujoco)
+    comparison = wp.equal_time_comparison(ours, mujoco)
     rows = {r["dt"]: r for r in comparison["rows"]}
     assert rows[1e-2]["how"] == "clamped" and rows[1e-2]["ratio"] == pytest.approx(100.0)
     # 1e-2 s lies halfway between 1e-3 and 1e-1 s in log time: error sqrt(1e-1 * 1e-2).
