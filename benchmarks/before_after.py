@@ -40,28 +40,26 @@ ARGUMENTS = {"engine": ("--quick", "--models", "manipulator,diff_drive"), "envs"
 """Each benchmark's arguments: quick budgets; the engine on both mission models."""
 
 
-def _harness(tree: Path, scratch: Path) -> Path:
-    """A folder with ``tree``'s packages and this tree's ``benchmarks``."""
-    folder = scratch / f"harness-{abs(hash(str(tree)))}"
-    if not folder.exists():
-        folder.mkdir()
+def _run_in(tree: Path, scratch: Path, *args: str) -> str:
+    """Stdout of ``python -m benchmarks.ARGS`` on ``tree``'s packages and this ``benchmarks``."""
+    harness = scratch / f"harness-{abs(hash(str(tree)))}"
+    if not harness.exists():
+        harness.mkdir()
         for package in ("mdi_envs", "optimal", "baselines"):
-            (folder / package).symlink_to(tree / package)
-        (folder / "benchmarks").symlink_to(ROOT / "benchmarks")
-    return folder
+            (harness / package).symlink_to(tree / package)
+        (harness / "benchmarks").symlink_to(ROOT / "benchmarks")
+    process = subprocess.run([sys.executable, "-m", f"benchmarks.{args[0]}", *args[1:]],
+                             cwd=harness, env={**os.environ, "PYTHONPATH": str(harness)},
+                             capture_output=True, text=True, check=False)
+    if process.returncode != 0:
+        raise RuntimeError(f"benchmarks.{args[0]} on {tree} failed: "
+                           f"{process.stderr.strip().splitlines()[-1:]}")
+    return process.stdout
 
 
 def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]]:
     """Run ``benchmarks.<name>`` (``ARGUMENTS``) on the package in ``tree``; its targets."""
-    harness = _harness(tree, folder.parent)
-    environment = {**os.environ, "PYTHONPATH": str(harness)}
-    process = subprocess.run(
-        [sys.executable, "-m", f"benchmarks.{name}", *ARGUMENTS[name], "--output", str(folder)],
-        cwd=harness, env=environment, capture_output=True, text=True, check=False,
-    )
-    if process.returncode != 0:
-        raise RuntimeError(f"benchmarks.{name} on {tree} failed: "
-                           f"{process.stderr.strip().splitlines()[-1:]}")
+    _run_in(tree, folder.parent, name, *ARGUMENTS[name], "--output", str(folder))
     filename = dict(BENCHMARKS)[name]
     record = json.loads((folder / filename).read_text())
     found = _targets(record)
@@ -73,13 +71,7 @@ def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]
 
 def in_place_once(tree: Path, model: str, scratch: Path) -> tuple[float, float]:
     """(min, median) µs of ``benchmarks.in_place_probe MODEL`` on the package in ``tree``."""
-    harness = _harness(tree, scratch)
-    process = subprocess.run(
-        [sys.executable, "-m", "benchmarks.in_place_probe", model], cwd=harness,
-        env={**os.environ, "PYTHONPATH": str(harness)}, capture_output=True, text=True,
-        check=True,
-    )
-    fastest, median = process.stdout.split()
+    fastest, median = _run_in(tree, scratch, "in_place_probe", model).split()
     return float(fastest), float(median)
 
 
@@ -121,10 +113,7 @@ def run(before: Path, rounds: int, output: Path) -> str:
     output.mkdir(parents=True, exist_ok=True)
     (output / "before_after.json").write_text(json.dumps(record, indent=2))
     _plot(rows, output / "before_after.png")
-    return report.markdown_table([{
-        "target": row["target"], "unit": row["unit"], "before (median)": f"{row['before']:.4g}",
-        "after (median)": f"{row['after']:.4g}", f"slowdown after/before (limit {LIMIT:g})":
-        f"{row['slowdown']:.3f}{'' if row['ok'] else ' (over)'}"} for row in rows])
+    return report.flat_table(rows, ["target", "unit", "before", "after", "slowdown", "ok"])
 
 
 def _plot(rows: list[dict[str, Any]], path: Path) -> None:

@@ -16,22 +16,17 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-BENCHMARKS = {
+BENCHMARKS = {  # NAME: (module with ``main(argv)``, what it measures)
     "solvers": ("benchmarks.solvers", "LCP methods: work vs size, Lemke vs QuantEcon"),
-    "engine": ("benchmarks.engine", "stepper µs per step (single, batched) vs MuJoCo, the "
-               "shortcut ablation (on vs off: equality, speedup), brake stop vs MuJoCo"),
-    "envs": ("benchmarks.envs", "env.step via gym.make and vector-env throughput vs "
-             "Acrobot-v1 and MuJoCo"),
-    "precision": ("benchmarks.work_precision", "error vs wall time per scene vs closed form, "
+    "engine": ("benchmarks.engine", "µs per step (single, batched) vs MuJoCo, the shortcuts, "
+               "the brake stop"),
+    "envs": ("benchmarks.envs", "env.step and vector-env throughput vs Acrobot-v1 and MuJoCo"),
+    "precision": ("benchmarks.work_precision", "error vs wall time per scene vs closed forms, "
                   "the event-driven reference and MuJoCo"),
-    "fc3d": ("benchmarks.fc3d", "every FC3D method on the 35 Siconos fc3d peer problems"),
-    "stress": ("benchmarks.stress", "numerical stress cases with pass/fail criteria (the "
-               "pytest cases of tests/stress)"),
-    "startup": ("benchmarks.startup", "interpreter start to the first env step, warm and "
-                "cold kernel cache, vs Acrobot-v1 and MuJoCo; mdi-envs compile all"),
+    "fc3d": ("benchmarks.fc3d", "every FC3D method on the Siconos fc3d peer problems"),
+    "stress": ("benchmarks.stress", "the stress cases of tests/stress with their criteria"),
+    "startup": ("benchmarks.startup", "interpreter start to the first env step, warm and cold"),
 }
-"""NAME -> (module with ``main(argv)``, what it measures)."""
-
 DEFAULT_OUTPUT = Path("benchmarks/results")
 """Where the full run writes (committed); ``--quick`` writes into its ``quick/`` subfolder."""
 

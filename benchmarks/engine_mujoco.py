@@ -81,10 +81,8 @@ class MujocoArm:
         """(model, data) of a scene: the manipulator scenes' state in MuJoCo coordinates."""
         model = self.tresca if scene == "tresca" else self.plain
         data = self.mujoco.MjData(model)
-        alpha, beta = MANIPULATOR_Q
-        alpha_dot, beta_dot = MANIPULATOR_U
-        data.qpos[:] = (alpha, beta - alpha)
-        data.qvel[:] = (alpha_dot, beta_dot - alpha_dot)
+        (alpha, beta), (alpha_dot, beta_dot) = MANIPULATOR_Q, MANIPULATOR_U
+        data.qpos[:], data.qvel[:] = (alpha, beta - alpha), (alpha_dot, beta_dot - alpha_dot)
         data.ctrl[0] = MOTOR_TORQUE
         data.eq_active[0] = 1 if scene == "engaged" else 0
         return model, data
@@ -120,11 +118,9 @@ class MujocoArm:
             state = np.empty(mj.mj_stateSize(model, self.state_spec))
             mj.mj_getState(model, data, state, self.state_spec)
             per_scene[scene] = (model, state, (MOTOR_TORQUE, 1.0 if scene == "engaged" else 0.0))
-        picks = [per_scene[scenes[i % len(scenes)]] for i in range(num_copies)]
-        models = [pick[0] for pick in picks]
-        states = [pick[1] for pick in picks]
-        controls = [pick[2] for pick in picks]
-        initial = np.array(states)
+        models, states, controls = zip(*(per_scene[scenes[i % len(scenes)]]
+                                         for i in range(num_copies)), strict=True)
+        models, initial = list(models), np.array(states)
         control = np.repeat(np.array(controls)[:, None, :], num_steps, axis=1)
         out_state = np.empty((num_copies, num_steps, initial.shape[1]))
         out_sensor = np.empty((num_copies, num_steps, 0))
@@ -161,14 +157,9 @@ class MujocoArm:
             if speed < 0.01:
                 steps = k
                 break
-        return {
-            "solref": list(model.eq_solref[0]),
-            "solimp": list(model.eq_solimp[0]),
-            "steps": steps,
-            "relative_angle_at_stop": float(data.qpos[1]),
-            "largest_relative_angle": largest_angle,
-            "relative_speed_trace": trace,
-        }
+        return {"solref": list(model.eq_solref[0]), "solimp": list(model.eq_solimp[0]),
+                "steps": steps, "relative_angle_at_stop": float(data.qpos[1]),
+                "largest_relative_angle": largest_angle, "relative_speed_trace": trace}
 
     def close(self) -> None:
         """Shut down the rollout thread pool, if one was made."""
@@ -192,9 +183,7 @@ BALL_MJCF = """
 """
 
 BALL_TIMECONST = 0.02  # [s] the contact's solref time constant (MuJoCo's default)
-
 CALIBRATION_DROP = 0.5  # [m] drop of the calibration run
-
 CALIBRATION_XTOL = 1e-7  # on the calibrated dampratio
 
 

@@ -15,20 +15,11 @@ import numpy as np
 from mdi_envs import mechanics
 from mdi_envs.stepping import MoreauJeanStepper, StepShortcuts
 
-TIME_STEP = 1e-3
-"""Step of every stepper and of MuJoCo [s]."""
-
-TRESCA_BOUND = 0.5
-"""Brake torque bound a [N m] of the manipulator's Tresca scenes (and MuJoCo's frictionloss)."""
-
-MOTOR_TORQUE = 1.0
-"""Motor torque tau [N m] on alpha in every manipulator scene (and on MuJoCo's joint 1)."""
-
-MANIPULATOR_Q = (0.3, 0.8)
-"""Manipulator scenes' (alpha, beta) [rad]: relative angle beta - alpha = 0.5."""
-
-MANIPULATOR_U = (0.5, 1.0)
-"""Manipulator scenes' (alpha', beta') [rad/s]: relative velocity 0.5 (an engaged brake impacts)."""
+TIME_STEP = 1e-3  # [s] of every stepper and of MuJoCo
+TRESCA_BOUND = 0.5  # [N m] the Tresca scenes' brake bound (MuJoCo: frictionloss)
+MOTOR_TORQUE = 1.0  # [N m] on alpha in every manipulator scene (MuJoCo: joint 1)
+MANIPULATOR_Q = (0.3, 0.8)  # [rad] (alpha, beta): relative angle 0.5
+MANIPULATOR_U = (0.5, 1.0)  # [rad/s]: relative velocity 0.5 (an engaged brake impacts)
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import numba
 import numpy as np
 
 import mdi_envs
@@ -90,8 +91,7 @@ def _sample_actions(space: gym.Space, count: int, seed: int) -> list[Any]:
     return [space.sample() for _ in range(count)]
 
 
-STEPS_PER_CALL = 64
-"""``env.step`` calls per timed call of a ``StepLoop``."""
+STEPS_PER_CALL = 64  # ``env.step`` calls per timed call of a ``StepLoop``.
 
 
 class StepLoop:
@@ -126,13 +126,13 @@ class StepLoop:
         self.chunk = (self.chunk + 1) % len(self.chunks)
 
 
+@dataclass
 class VectorLoop:
     """One vector ``step`` per call with the next pre-sampled action batch (autoreset inside)."""
 
-    def __init__(self, env: Any, actions: list[Any]) -> None:
-        self.env = env
-        self.actions = actions
-        self.index = 0
+    env: Any
+    actions: list[Any]
+    index: int = 0
 
     def __call__(self) -> None:
         """Step every copy once."""
@@ -272,19 +272,13 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str]
         measured = []
         for key, value in timed.items():
             summary = value.summary()
-            info = meta[key]
-            skip = info["frame_skip"]
-            row = {
-                **info,
-                "call": summary,
-                "env_steps_per_s": n / summary["median_s"],
-                "env_steps_per_s_q1": n / summary["q3_s"],
-                "env_steps_per_s_q3": n / summary["q1_s"],
-                "env_steps_per_s_best": n / summary["min_s"],
-                "per_env_step_us": summary["median_s"] / n * 1e6,
-            }
+            row = {**meta[key], "call": summary,
+                   **{f"env_steps_per_s{k}": n / summary[f"{stat}_s"] for k, stat in
+                      (("", "median"), ("_q1", "q3"), ("_q3", "q1"), ("_best", "min"))},
+                   "per_env_step_us": summary["median_s"] / n * 1e6}
             for name in ("", "_q1", "_q3", "_best"):
-                row[f"physics_steps_per_s{name}"] = row[f"env_steps_per_s{name}"] * skip
+                row[f"physics_steps_per_s{name}"] = (row[f"env_steps_per_s{name}"]
+                                                      * meta[key]["frame_skip"])
             measured.append(row)
             loops[key].env.close()
         rows += measured
@@ -345,17 +339,6 @@ def _pin(cpu: int | None) -> tuple[set[int] | None, dict[str, Any]]:
     return previous, {"pinned": True, "cpus": sorted(os.sched_getaffinity(0))}
 
 
-def _numba_info() -> dict[str, Any]:
-    """Numba's threading settings (the env kernels are not parallel, so they run on 1 thread)."""
-    try:
-        import numba
-    except ImportError:
-        return {}
-    return {"num_threads": numba.config.NUMBA_NUM_THREADS,
-            "threading_layer": numba.config.THREADING_LAYER,
-            "parallel_kernels_used": False}
-
-
 def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None] | None = None
         ) -> str:
     """Run the whole benchmark, write the outputs and return the Markdown report."""
@@ -368,14 +351,12 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
         record: dict[str, Any] = {
             "machine": timing.machine_info(VERSIONED),
             "pinning": pinning,
-            "numba_threading": _numba_info(),
+            "numba_threading": {"num_threads": numba.config.NUMBA_NUM_THREADS,
+                                "threading_layer": numba.config.THREADING_LAYER,
+                                "parallel_kernels_used": False},
             "config": {"quick": quick, "env_ids": env_ids,
                        **{k: v for k, v in asdict(config).items() if k != "env_ids"}},
-            "units": UNITS,
-            "targets_brief": TARGETS,
-            "notes": [],
-            "load_log": [],
-        }
+            "units": UNITS, "targets_brief": TARGETS, "notes": [], "load_log": []}
         log(f"env benchmark ({'quick' if quick else 'full'}) -> {output}; pinned to "
             f"{pinning['cpus']}; load {timing.load_text()}")
         timing.checkpoint(record, "single env", progress.elapsed)
@@ -387,13 +368,9 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
             record["notes"].append(f"{item['env_id']}"
                                    f"{' (' + item['mode'] + ')' if 'mode' in item else ''} "
                                    f"not measured: {item['error']}")
-        record.update({
-            "single_env": single,
-            "unavailable": unavailable,
-            "vector_env": vector,
-            "vector_unavailable": vector_unavailable,
-            "targets": evaluate_targets(single, vector),
-        })
+        record.update({"single_env": single, "unavailable": unavailable, "vector_env": vector,
+                       "vector_unavailable": vector_unavailable,
+                       "targets": evaluate_targets(single, vector)})
         plot_step(single, unavailable, TARGETS, output / "envs_step.png")
         plot_vector(vector, TARGETS, output / "envs_vector.png")
         timing.finish(record, progress.elapsed, speed=True)
@@ -406,18 +383,9 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
     return markdown_report(record)
 
 
-SHORT_NAMES = {
-    "mdi_envs/BlockableManipulator-v0": "BlockableManipulator",
-    "mdi_envs/DiffDriveRobot-v0": "DiffDriveRobot",
-}
-
-
 def short_name(env_id: str) -> str:
     """A short label: ``mdi_envs/BlockableManipulator-v0`` -> ``BlockableManipulator``."""
-    if env_id in SHORT_NAMES:
-        return SHORT_NAMES[env_id]
-    name = env_id.split("/")[-1]
-    return name[:-3] if env_id.startswith("mdi_envs/") and name.endswith("-v0") else name
+    return env_id.split("/")[-1].removesuffix("-v0") if env_id.startswith("mdi_envs/") else env_id
 
 
 def markdown_report(record: Mapping[str, Any]) -> str:

@@ -17,9 +17,7 @@ import numpy as np
 from mdi_envs._types import FloatArray
 from mdi_envs.solvers.siconos_io import read_lcp
 
-SEED = 20_240_601
-"""Root seed of every random benchmark problem."""
-
+SEED = 20_240_601  # Root seed of every random benchmark problem.
 CONTACTS_PER_BODY = 6
 CFM_SHIFT = 0.01
 """Diagonal shift of the contact family, relative to the mean diagonal of ``J J^T``."""

@@ -33,7 +33,7 @@ ENTRY_TITLES = {"quantecon": "QuantEcon lcp_lemke"}
 
 @dataclass(frozen=True)
 class BenchConfig:
-    """Grid and timing budgets of one run."""
+    """Sizes n and instances of the size study and the QuantEcon comparison, their timing."""
 
     sizes: tuple[int, ...]
     instances: int
@@ -45,32 +45,21 @@ class BenchConfig:
 
 
 FULL = BenchConfig(
-    sizes=(2, 3, 5, 10, 20, 50, 100, 200),
-    instances=5,
+    sizes=(2, 3, 5, 10, 20, 50, 100, 200), instances=5,
     size_plan=TimingPlan(budget_s=0.05, min_rounds=5, max_rounds=100),
-    peer_sizes=tuple(range(10, 101, 10)),
-    peer_instances=2,
-    peer_plan=TimingPlan(budget_s=0.25, min_rounds=9, max_rounds=400),
-    cold_compile=True,
-)
+    peer_sizes=tuple(range(10, 101, 10)), peer_instances=2,
+    peer_plan=TimingPlan(budget_s=0.25, min_rounds=9, max_rounds=400), cold_compile=True)
 QUICK = BenchConfig(
-    sizes=(2, 5, 10, 50),
-    instances=2,
+    sizes=(2, 5, 10, 50), instances=2,
     size_plan=TimingPlan(budget_s=0.005, min_rounds=3, max_rounds=20),
-    peer_sizes=(10, 50, 100),
-    peer_instances=1,
-    peer_plan=TimingPlan(budget_s=0.02, min_rounds=3, max_rounds=30),
-    cold_compile=False,
-)
+    peer_sizes=(10, 50, 100), peer_instances=1,
+    peer_plan=TimingPlan(budget_s=0.02, min_rounds=3, max_rounds=30), cold_compile=False)
 
 
 def measure_first_calls(config: BenchConfig, log: Progress) -> dict[str, Any]:
     """First-call (compile or cache-load) times, each from a fresh interpreter."""
-    probes = {"warm_cache": False}
-    if config.cold_compile:
-        probes["cold_cache"] = True
     results = {}
-    for label, cold in probes.items():
+    for label, cold in (("warm_cache", False), ("cold_cache", True))[:1 + config.cold_compile]:
         log(f"first-call probe ({label}) in a fresh interpreter ...")
         results[label] = timing.probe_first_calls(cold)
         calls = results[label].get("first_call_s", {})

@@ -27,8 +27,7 @@ REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
 """Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
 row, ``startup_probe.FLOOR``) the floor of any numba env: one trivial cached kernel's load."""
 ENTRIES = ("single", "vector", "subproc")
-TARGET_RATIO = 2.0
-"""Warm start-up target: within this factor of Acrobot-v1's, entry by entry."""
+TARGET_RATIO = 2.0  # Warm start-up target: within this factor of Acrobot-v1's, entry by entry.
 ROOT = Path(__file__).resolve().parents[1]
 
 

@@ -10,8 +10,7 @@ import json
 import sys
 import time
 
-FLOOR = "numba-floor"
-"""The pseudo id of the numba floor case (see the module docstring)."""
+FLOOR = "numba-floor"  # The pseudo id of the numba floor case (see the module docstring).
 
 
 def main(argv: list[str]) -> None:
@@ -34,13 +33,8 @@ def main(argv: list[str]) -> None:
         print(json.dumps({"done": time.time(), "phases": phases}), flush=True)
         return
     phases["import"] = time.perf_counter() - began
-    if entry == "single":
-        env = gym.make(env_id)
-        env.reset(seed=0)
-        phases["make_reset"] = time.perf_counter() - began - phases["import"]
-        env.step(env.action_space.sample())
-    elif entry == "vector":
-        env = gym.make_vec(env_id, num_envs=64)
+    if entry in ("single", "vector"):
+        env = gym.make(env_id) if entry == "single" else gym.make_vec(env_id, num_envs=64)
         env.reset(seed=0)
         phases["make_reset"] = time.perf_counter() - began - phases["import"]
         env.step(env.action_space.sample())

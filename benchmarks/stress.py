@@ -21,8 +21,7 @@ import pytest
 from benchmarks import report
 from benchmarks.timing import arguments, load_average, machine_info
 
-TESTS = Path(__file__).resolve().parents[1] / "tests" / "stress"
-"""The folder of the stress cases."""
+TESTS = Path(__file__).resolve().parents[1] / "tests" / "stress"  # The folder of the stress cases.
 MARGIN_FLOOR, MARGIN_CEILING = 1e-9, 1e9
 """Margins are drawn within these (a zero count at the floor; a failed count, NaN, inf above)."""
 

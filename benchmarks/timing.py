@@ -53,14 +53,9 @@ class Timed:
     def summary(self, operations_per_call: int = 1) -> dict[str, float | int]:
         """The times as a JSON-ready dict, per operation (``operations_per_call`` per call)."""
         per = operations_per_call
-        return {
-            "median_s": self.median_s / per,
-            "min_s": self.min_s / per,
-            "q1_s": self.q1_s / per,
-            "q3_s": self.q3_s / per,
-            "rounds": self.rounds,
-            "number": self.number,
-        }
+        return {"median_s": self.median_s / per, "min_s": self.min_s / per,
+                "q1_s": self.q1_s / per, "q3_s": self.q3_s / per, "rounds": self.rounds,
+                "number": self.number}
 
 
 def _timed_call(call: Callable[[], Any]) -> tuple[Any, float]:
@@ -77,10 +72,8 @@ def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -
     least ``plan.min_batch_s``; the time per call is the median over rounds of batch / number.
     """
     warm = {name: _timed_call(call) for name, call in calls.items()}
-    numbers = {
-        name: max(1, math.ceil(plan.min_batch_s / max(seconds, 1e-9)))
-        for name, (_, seconds) in warm.items()
-    }
+    numbers = {name: max(1, math.ceil(plan.min_batch_s / max(seconds, 1e-9)))
+               for name, (_, seconds) in warm.items()}
     slowest = max(numbers[name] * warm[name][1] for name in calls)
     rounds = min(plan.max_rounds, max(plan.min_rounds, int(plan.budget_s / max(slowest, 1e-9))))
     samples: dict[str, list[float]] = {name: [] for name in calls}
@@ -88,13 +81,9 @@ def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -
     for _ in range(rounds):
         for name, timer in timers.items():
             samples[name].append(timer.timeit(numbers[name]) / numbers[name])
-    timed = {}
-    for name, values in samples.items():
-        q1, median, q3 = np.percentile(values, [25, 50, 75])
-        timed[name] = Timed(
-            warm[name][0], float(median), min(values), float(q1), float(q3), rounds, numbers[name]
-        )
-    return timed
+    quartiles = {name: np.percentile(values, [25, 50, 75]) for name, values in samples.items()}
+    return {name: Timed(warm[name][0], float(q[1]), min(samples[name]), float(q[0]), float(q[2]),
+                        rounds, numbers[name]) for name, q in quartiles.items()}
 
 
 def probe_first_calls(cold: bool) -> dict[str, Any]:
@@ -104,21 +93,15 @@ def probe_first_calls(cold: bool) -> dict[str, Any]:
         if cold:  # numba's cache for other code, the package's own (mdi_envs._kernel_cache)
             env["NUMBA_CACHE_DIR"] = cache_dir
             env["MDI_ENVS_CACHE_DIR"] = cache_dir
-        process = subprocess.run(
-            [sys.executable, "-m", "benchmarks.first_call"],
-            cwd=Path(__file__).resolve().parents[1],
-            env=env,
-            capture_output=True,
-            text=True,
-            check=False,
-        )
+        process = subprocess.run([sys.executable, "-m", "benchmarks.first_call"],
+                                 cwd=Path(__file__).resolve().parents[1], env=env,
+                                 capture_output=True, text=True, check=False)
     if process.returncode != 0:
         return {"error": process.stderr.strip().splitlines()[-1:]}
     return json.loads(process.stdout)
 
 
 def _package_version(name: str) -> str | None:
-    """Installed version of a distribution, or None."""
     try:
         return metadata.version(name)
     except metadata.PackageNotFoundError:

@@ -57,7 +57,6 @@ from mdi_envs.stepping._kernel import INFO_STATUS
 from mdi_envs.stepping.event_driven import EVENT_APEX, EVENT_IMPACT, Trajectory
 
 Log = Callable[[str], None]
-
 METHODS = {"enumerative": StepShortcuts(), "lemke": StepShortcuts(direct_solve_max_size=0)}
 ATOL_PER_RTOL = 1e-2  # event-driven runs: atol = ATOL_PER_RTOL * rtol
 BOUNCES = 3  # ball apexes compared (impacts 2 .. BOUNCES + 1 for the times)
@@ -155,9 +154,18 @@ class Context:
     _compiled: set[tuple[str, str]] = field(default_factory=set)
 
     def timed(self, call: Callable[[], Any]) -> tuple[float, int, Any]:
-        """Best wall time [s] of ``call()`` (see ``wall_time``) under this run's plan."""
-        plan = self.config.timing
-        return wall_time(call, plan.min_rounds, plan.budget_s, plan.max_rounds)
+        """(best wall time [s] of ``call()``, repeats, the untimed warm-up call's result).
+
+        As many timed calls (``timeit``, GC on) as fit in the plan's budget by the warm-up's
+        duration, within its least and most rounds.
+        """
+        plan, start = self.config.timing, time.perf_counter()
+        result = call()
+        first = time.perf_counter() - start
+        fits = int(plan.budget_s / max(first, 1e-9))
+        repeats = min(plan.max_rounds, max(plan.min_rounds, 1, fits))
+        timer = timeit.Timer(call, setup="gc.enable()")
+        return min(timer.repeat(repeat=repeats, number=1)), repeats, result
 
     def stepper(self, model: Any, parameters: Any, dt: float, method: str = "enumerative",
                 locate_impacts: bool = False) -> MoreauJeanStepper:
@@ -175,17 +183,6 @@ class Context:
             self.log(f"  {seconds:.1f} s")
             self._compiled.add(key)
         return st
-
-
-def wall_time(call: Callable[[], Any], min_repeats: int, budget_s: float, max_repeats: int
-              ) -> tuple[float, int, Any]:  # fmt: skip
-    """Best wall time of ``call()`` (``timeit.Timer.repeat``, one call per repeat, GC on)."""
-    start = time.perf_counter()
-    result = call()
-    first = time.perf_counter() - start
-    repeats = min(max_repeats, max(min_repeats, 1, int(budget_s / max(first, 1e-9))))
-    timer = timeit.Timer(call, setup="gc.enable()")
-    return min(timer.repeat(repeat=repeats, number=1)), repeats, result
 
 
 class Copies:
@@ -338,6 +335,13 @@ def ball_event_errors(p: BouncingBallParameters, gaps: np.ndarray, runs: list[Tr
     return _ball_summary(per_drop)
 
 
+def _ball_setup(ctx: Context) -> tuple[BouncingBallParameters, WorkPrecisionConfig, np.ndarray,
+                                      float]:
+    """The ball's parameters, the run's configuration, the drops' gaps [m] and the horizon [s]."""
+    p, gaps = BouncingBallParameters(), drop_gaps(ctx.config.ball_drops)
+    return p, ctx.config, gaps, ball_horizon(p, gaps)
+
+
 def _ball_initial(p: BouncingBallParameters, gaps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     q0 = np.column_stack([np.zeros(gaps.size), p.radius + gaps])
     return q0, np.zeros_like(q0)
@@ -345,9 +349,7 @@ def _ball_initial(p: BouncingBallParameters, gaps: np.ndarray) -> tuple[np.ndarr
 
 def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
     """Moreau-Jean ball points: per method and dt, drop 0 timed, D drops replayed step by step."""
-    p, config = BouncingBallParameters(), ctx.config
-    gaps = drop_gaps(config.ball_drops)
-    horizon = ball_horizon(p, gaps)
+    p, config, gaps, horizon = _ball_setup(ctx)
     points = []
     variants = [(f"mj_{method}", method, False) for method in config.methods]
     for series, method, locate_impacts in [*variants, ("mj_located", "enumerative", True)]:
@@ -371,9 +373,7 @@ def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
 
 def ball_event_driven(ctx: Context) -> list[dict[str, Any]]:
     """Event-driven ball points: per rtol, drop 0 timed, every drop's events compared."""
-    p, config = BouncingBallParameters(), ctx.config
-    gaps = drop_gaps(config.ball_drops)
-    horizon = ball_horizon(p, gaps)
+    p, config, gaps, horizon = _ball_setup(ctx)
     points = []
     for rtol in config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
@@ -388,9 +388,7 @@ def ball_event_driven(ctx: Context) -> list[dict[str, Any]]:
 
 def ball_mujoco(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """MuJoCo ball points per dampratio mapping and dt, and the calibration records."""
-    p, config = BouncingBallParameters(), ctx.config
-    gaps = drop_gaps(config.ball_drops)
-    horizon = ball_horizon(p, gaps)
+    p, config, gaps, horizon = _ball_setup(ctx)
     points, calibrations = [], []
     for series in config.mujoco_ball_series:
         for dt in config.mujoco_ball_time_steps:
@@ -935,7 +933,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 __all__ = ["FULL", "QUICK", "WorkPrecisionConfig", "ball_errors", "evaluate_targets", "main",
-           "observed_order", "run", "wall_time"]
+           "observed_order", "run"]
 
 
 if __name__ == "__main__":
