@@ -8,9 +8,11 @@ engage <= release: a phase may shrink to an instant (engage = release: a plastic
 relative velocity, then released) and may end at t_f (engaged to the end; an instant at t_f is
 an impulsive stop). ``simulate_schedule`` runs it through the project's event-driven
 integrator (``mdi_envs.stepping.event_driven``: DOP853, the impact law at every engagement);
-``polish`` minimizes t_f over all times with SciPy's SLSQP, the ordering of the times as linear
-bounds on their gaps and the goal (``problem.goal_q``, ``goal_u`` after the events at t_f) as
-equality constraints, gradients by central differences (one-sided at an active ordering).
+``polish`` minimizes t_f with SciPy's SLSQP over the gaps between consecutive times (bounds
+>= 0 keep the order at every iterate; each brake's and input's gaps sum to the same t_f), the
+goal (``problem.goal_q``, ``goal_u`` after the events at t_f) as equality constraints,
+gradients by central differences (one-sided at an active bound). A brake engaged at t_f
+stays engaged; its velocity goal is then stated in the directions the lock leaves free.
 
 Only time-optimal problems of models the event-driven integrator handles (constant brake and
 contact directions, frictionless contacts) with bang-bang inputs: the blockable manipulator and
