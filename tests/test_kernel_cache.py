@@ -228,10 +228,10 @@ def test_an_edited_package_recompiles_with_its_new_code(
 
 def test_subproc_vec_env_workers_compiling_together(
         shared_cache: tuple[Path, list[dict]]) -> None:
-    # the package's solver kernels are in the shared cache; the ball's step and task kernels
+    # the package's solver kernels are in the shared cache; the ball's step and scene kernels
     # are not: both workers compile them at once
     cache, _ = shared_cache
-    assert not list(cache.glob("*/kernels/mdi_envs_kernels_task_BouncingBall*.py"))
+    assert not list(cache.glob("*/kernels/mdi_envs_kernels_scene_BouncingBall*.py"))
     script = (
         "import numpy as np, mdi_envs\n"
         "from stable_baselines3.common.env_util import make_vec_env\n"
@@ -250,4 +250,4 @@ def test_subproc_vec_env_workers_compiling_together(
     for run in runs:
         assert run.returncode == 0, run.stderr[-3000:]
     assert runs[0].stdout == runs[1].stdout  # the second run, from the cache, agrees
-    assert list(cache.glob("*/kernels/mdi_envs_kernels_task_BouncingBall*.py"))
+    assert list(cache.glob("*/kernels/mdi_envs_kernels_scene_BouncingBall*.py"))
