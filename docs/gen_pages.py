@@ -14,6 +14,7 @@ No kernel is compiled: env classes are never imported, only their source is pars
 from __future__ import annotations
 
 import json
+import re
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -30,8 +31,10 @@ from baselines.tables import comparison_table, robustness_table
 from optimal import available_references, load_reference
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "docs"))
+sys.path[:0] = [str(ROOT), str(ROOT / "docs")]  # benchmarks/ is not installed
 import headline  # noqa: E402  (docs/headline.py)
+
+from benchmarks.report import targets_table  # noqa: E402
 
 NAMESPACE = "mdi_envs/"
 API_PACKAGES = ("mdi_envs.solvers", "mdi_envs.stepping", "mdi_envs.mechanics", "mdi_envs.envs",
@@ -52,10 +55,18 @@ def copy_image(source: Path, folder: str) -> str:
     return f"img/{source.name}"
 
 
+ISSUE_NOTE = re.compile(r"\s*\([^()]*\bissue\b[^()]*\)")
+"""A parenthesis naming a project issue in a result's note: history, not a result."""
+
+
+def clean(text: str) -> str:
+    """``text`` without parentheses naming issues."""
+    return ISSUE_NOTE.sub("", text)
+
+
 def table(rows: list[dict[str, Any]], floatfmt: str = ".4g") -> str:
-    """A Markdown table of records (pandas ``to_markdown``); notes naming issues are dropped."""
-    frame = pd.DataFrame(rows).replace(r"\s*\([^()]*\bissue\b[^()]*\)", "", regex=True)
-    return frame.to_markdown(index=False, floatfmt=floatfmt)
+    """A Markdown table of records (pandas ``to_markdown``), cleaned."""
+    return clean(pd.DataFrame(rows).to_markdown(index=False, floatfmt=floatfmt))
 
 
 # --- environments -----------------------------------------------------------------------------
@@ -211,11 +222,12 @@ def benchmark_page() -> None:
              "(../guide/benchmarks.md).", ""]
     headline = folder / "headline.json"
     if headline.exists():
-        rows = [{k: r.get(k) for k in ("benchmark", "target", "measured", "comparison",
-                                       "threshold", "unit", "met", "note")}
-                for r in load(headline)["rows"]]
-        lines += ["## Headline", "", "Every target of the suite (`benchmarks/results/"
-                  "headline.json`).", "", table(rows), ""]
+        rows = load(headline)["rows"]
+        lines += ["## Headline", "", "Every target of the suite, per benchmark "
+                  "(`benchmarks/results/headline.json`, `benchmarks.report.targets_table`).", ""]
+        for name in dict.fromkeys(r["benchmark"] for r in rows):
+            lines += [f"**{name}**", "", clean(targets_table(
+                [r for r in rows if r["benchmark"] == name])), ""]
     for stem, (title, command) in BENCHMARKS.items():
         path = folder / f"{stem}.json"
         if not path.exists():
@@ -223,7 +235,9 @@ def benchmark_page() -> None:
         run = load(path)
         lines += [f"## {title}", "", f"`{command}` writes `benchmarks/results/{stem}.json`. "
                   + machine_text(run), ""]
-        targets = run.get("targets") or run.get("rows")
+        targets = None
+        if run.get("targets"):
+            lines += [clean(targets_table(run["targets"])), ""]
         if stem == "solvers":
             lines += solver_tables(run)
         if stem == "stress":
