@@ -312,7 +312,7 @@ def storage(url: str = DEFAULT_STORAGE) -> Any:
     """The RDB storage at ``url``, with heartbeats.
 
     A trial whose worker died is marked failed 10 min after its last heartbeat and enqueued
-    again once (``RetryFailedTrialCallback``).
+    again once (``RetryHeartbeatStaleTrialCallback``).
     """
     import optuna
 
@@ -320,7 +320,8 @@ def storage(url: str = DEFAULT_STORAGE) -> Any:
         Path(url.removeprefix("sqlite:///")).parent.mkdir(parents=True, exist_ok=True)
     return optuna.storages.RDBStorage(
         url, heartbeat_interval=60, grace_period=600,
-        heartbeat_stale_trial_callback=optuna.storages.RetryFailedTrialCallback(max_retry=1))
+        heartbeat_stale_trial_callback=optuna.storages.RetryHeartbeatStaleTrialCallback(
+            max_retry=1))
 
 
 def load_study(name: str, url: str = DEFAULT_STORAGE) -> Any:
