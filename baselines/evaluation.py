@@ -1,17 +1,17 @@
 """The evaluation framework: play controllers under conditions into a ``Study``, merge studies.
 
 ``evaluate(env_id, objective, conditions)`` plays every controller row of (env id, objective): the
-untrained controllers (``CONTROLLER_FACTORIES``: the optimal reference played open loop through
-the same env id with one env step per interval of the transcription; heuristics or an MPC join
-by adding a factory) and every trained policy in ``trained_dir`` (``STEM.zip`` + ``STEM.json``,
-one per training seed, grouped by algorithm). Each run is played deterministically from
-``reset(seed=s)``, s = 0 ... num_starts - 1, under each ``Condition``: the start perturbation
-scale (``reset_noise_scale``, 0.01 rad, rad/s, m, m/s by default) and optionally a model
-mismatch (``MISMATCHES``) in the env only. With ``nominal=True`` each run also plays the
-unperturbed start (seed 0) and keeps trajectories for the plots. A comparison is the study at
-the default scale (``baselines.cli``'s ``compare``); the robustness study adds larger scales
-and the mismatches (``baselines.robustness``). Every finished episode can be appended to a
-JSON-lines log; ``resume`` reads it back instead of playing again.
+untrained controllers (``CONTROLLER_FACTORIES``: the optimal reference played open loop through the
+same env id with one env step per interval of the transcription, and the heuristic floors of
+``baselines.heuristics``; an MPC joins by adding a factory) and every trained policy in
+``trained_dir`` (``STEM.zip`` + ``STEM.json``, one per training seed, grouped by algorithm). Each
+run is played deterministically from ``reset(seed=s)``, s = 0 ... num_starts - 1, under each
+``Condition``: the start perturbation scale (``reset_noise_scale``, 0.01 rad, rad/s, m, m/s by
+default) and optionally a model mismatch (``MISMATCHES``) in the env only. With ``nominal=True``
+each run also plays the unperturbed start (seed 0) and keeps trajectories for the plots. A
+comparison is the study at the default scale (``baselines.cli``'s ``compare``); the robustness
+study adds larger scales and the mismatches (``baselines.robustness``). Every finished episode can
+be appended to a JSON-lines log; ``resume`` reads it back instead of playing again.
 """
 
 from __future__ import annotations
@@ -123,7 +123,8 @@ class Controller:
 ControllerFactory = Callable[[str, str], "Controller | None"]
 """(env id, objective) -> a controller, or None where it does not apply."""
 
-CONTROLLER_FACTORIES: list[str] = ["baselines.evaluation:optimal_controller"]
+CONTROLLER_FACTORIES: list[str] = ["baselines.evaluation:optimal_controller",
+                                   "baselines.heuristics:heuristic_controller"]
 """The untrained controller rows, as "module:function" of a ``ControllerFactory`` (imported on
 use). ``register_controller`` adds one; every study plays them in this order."""
 

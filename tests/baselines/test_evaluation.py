@@ -26,6 +26,7 @@ from baselines.evaluation import (
     registered_controllers,
     shipped_policies,
 )
+from baselines.heuristics import BANG_BANG, FOLLOWER
 from baselines.records import OPTIMAL, Condition, Episode, Scores, Study, read_study, write_study
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
 from optimal.references import load_reference
@@ -95,8 +96,8 @@ def test_the_perturbation_scale_is_a_parameter(tmp_path: Path) -> None:
     study = evaluate(ROBOT, "time", [Condition(0.0), Condition(0.3)], num_starts=1,
                      trained_dir=tmp_path)  # fmt: skip
     assert [c.label for c in study.conditions] == ["perturbation 0", "perturbation 0.3"]
-    (row,) = study.rows  # no trained policies in tmp_path: the reference only
-    exact, far = (run.scores for run in row.runs)
+    assert [row.label for row in study.rows] == [OPTIMAL, FOLLOWER]  # no trained policies
+    exact, far = (run.scores for run in study.row(OPTIMAL).runs)
     # from the unperturbed start the open-loop optimum reaches the goal at its own t_f
     assert exact.success_rate == 1.0 and exact.time_ratio == pytest.approx(1.0, abs=1e-6)
     assert far.success_rate == 0.0  # 0.3 m / rad of start error: open loop cannot absorb it
@@ -126,12 +127,14 @@ def test_scores_count_only_successes() -> None:
 
 def test_the_controller_registry(monkeypatch: pytest.MonkeyPatch) -> None:
     assert CONTROLLER_FACTORIES[0] == "baselines.evaluation:optimal_controller"
-    assert [c.label for c in registered_controllers(ROBOT, "effort")] == [OPTIMAL]
+    assert [c.label for c in registered_controllers(ROBOT, "effort")] == [OPTIMAL, FOLLOWER]
+    assert [c.label for c in registered_controllers(MANIPULATOR, "time")] == [OPTIMAL, BANG_BANG]
     assert registered_controllers(MANIPULATOR, "effort") == []  # no reference: no row
     monkeypatch.setattr(evaluation_module, "CONTROLLER_FACTORIES", list(CONTROLLER_FACTORIES))
     register_controller(f"{__name__}:random_factory")
     register_controller(f"{__name__}:random_factory")  # idempotent
-    assert [c.label for c in registered_controllers(ROBOT, "time")] == [OPTIMAL, "random"]
+    assert [c.label for c in registered_controllers(ROBOT, "time")] == [OPTIMAL, FOLLOWER,
+                                                                       "random"]  # fmt: skip
     with pytest.raises(ValueError, match="module:function"):
         register_controller("random_factory")
 
@@ -200,10 +203,11 @@ def test_merge_orders_conditions_and_drops_withdrawn_rows(manipulator_study: Stu
     merged = merge(old, new, shipped=set())
     assert [c.label for c in merged.conditions] == ["perturbation 0.01", "perturbation 0.1",
                                                     "link masses -10 %"]  # fmt: skip
-    assert [row.label for row in merged.rows] == [OPTIMAL, "reference controls", "random"]
+    assert [row.label for row in merged.rows] == [OPTIMAL, BANG_BANG, "reference controls",
+                                                  "random"]  # fmt: skip
     assert [run.condition for run in merged.rows[0].runs] == [Condition(), mismatch]
     assert merged.rows[1] == old.rows[1]  # a row not played again is kept as it was
-    assert len(merge(old, new).rows) == 4  # no list of shipped algorithms: PPO kept
+    assert len(merge(old, new).rows) == 5  # no list of shipped algorithms: PPO kept
     with pytest.raises(ValueError, match="num_starts"):
         merge(old, dataclasses.replace(old, num_starts=3))
 
@@ -211,7 +215,8 @@ def test_merge_orders_conditions_and_drops_withdrawn_rows(manipulator_study: Stu
 def test_an_interrupted_study_resumes_from_its_log(tmp_path: Path,
                                                    monkeypatch: pytest.MonkeyPatch) -> None:
     path = tmp_path / "episodes.jsonl"
-    options: dict[str, Any] = {"num_starts": 2, "trained_dir": tmp_path, "log_path": path}
+    options: dict[str, Any] = {"num_starts": 2, "trained_dir": tmp_path, "log_path": path,
+                               "only": [OPTIMAL]}  # fmt: skip
     first = evaluate(ROBOT, "effort", **options)
     lines = path.read_text().splitlines()
     assert [json.loads(line)["episode"]["seed"] for line in lines] == [0, 1]

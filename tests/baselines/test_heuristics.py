@@ -1,0 +1,74 @@
+"""``baselines.heuristics``: the floors reach the goal the way they are meant to."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from baselines import heuristics
+from mdi_envs.maneuvers import MANIPULATOR_MANEUVER
+
+
+def test_rigid_arm_bang_bang_takes_the_double_integrators_time() -> None:
+    """Brake engaged throughout; time = the rigid body's bang-bang time into the goal box."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make("mdi_envs/BlockableManipulator-v1", reset_noise_scale=0.0)
+    policy = heuristics.rigid_arm_bang_bang(env)
+    obs, _ = env.reset(seed=0)
+    engaged, done = [], False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        engaged.append(info["brake_engaged"])
+        done = terminated or truncated
+    assert terminated and info["is_success"] and all(engaged)
+    p = env.unwrapped.scene.parameters
+    inertia = (p.link1_mass * p.link1_length**2 / 3 + p.link2_mass * p.link1_length**2
+               + p.link2_mass * p.link1_length * p.link2_length
+               + p.link2_mass * p.link2_length**2 / 3)  # rigid arm about the base
+    a = env.unwrapped.scene.max_torque / inertia
+    # full torque to the midpoint, full reverse until the speed falls to the tolerance
+    expected = 2 * math.sqrt(math.pi / a) - MANIPULATOR_MANEUVER.velocity_tolerance / a
+    assert info["elapsed_time"] == pytest.approx(expected, abs=3 * env.unwrapped.dt)
+
+
+def test_speed_profile_is_the_fastest_within_the_acceleration_circle() -> None:
+    """On a straight line: the triangle profile v = sqrt(2 a min(s, L - s)) (rest to rest)."""
+    s = np.linspace(0.0, 2.0, 2001)
+    v = heuristics.speed_profile(s, np.zeros_like(s), 1.5, 10.0)
+    np.testing.assert_allclose(v, np.sqrt(2 * 1.5 * np.minimum(s, 2.0 - s)), atol=1e-9)
+    capped = heuristics.speed_profile(s, np.zeros_like(s), 1.5, 1.0)
+    assert capped.max() == pytest.approx(1.0)
+    circle = heuristics.speed_profile(s, np.full_like(s, 2.0), 1.5, 10.0)  # radius 0.5 m
+    assert circle.max() == pytest.approx(math.sqrt(1.5 / 2.0))  # v^2 k = a
+
+
+def test_bezier_half_turn_is_close_to_a_semicircle() -> None:
+    radius = 0.5
+    s, xy, heading, curvature = heuristics.bezier_path(
+        [(0.0, 0.0, math.pi / 2), (2 * radius, 0.0, -math.pi / 2)], [4 * radius / 3])
+    # one cubic per half-turn: within 2 % of the circle's radius and length, a right turn
+    assert s[-1] == pytest.approx(math.pi * radius, rel=0.02)
+    assert heading[-1] - heading[0] == pytest.approx(-math.pi)
+    np.testing.assert_allclose(np.hypot(xy[:, 0] - radius, xy[:, 1]), radius, rtol=0.02)
+    np.testing.assert_allclose(curvature, -1 / radius, rtol=0.3)
+
+
+def test_rolling_path_follower_reaches_the_goal_without_slipping() -> None:
+    """Time objective from a perturbed start: at the goal, every step in the rolling mode."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make("mdi_envs/DiffDriveRobot-v1", reset_noise_scale=0.1)
+    policy = heuristics.rolling_path_follower(env)
+    obs, _ = env.reset(seed=3)
+    modes, done = [], False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        modes.append(info["slip_mode"])
+        done = terminated or truncated
+    assert terminated and info["is_success"]
+    assert set(modes) == {2}  # both wheels roll throughout
