@@ -315,13 +315,23 @@ def storage(url: str = DEFAULT_STORAGE) -> Any:
     again once (``RetryHeartbeatStaleTrialCallback``).
     """
     import optuna
+    from sqlalchemy.exc import IntegrityError, OperationalError
 
     if url.startswith("sqlite:///"):
         Path(url.removeprefix("sqlite:///")).parent.mkdir(parents=True, exist_ok=True)
-    return optuna.storages.RDBStorage(
-        url, heartbeat_interval=60, grace_period=600,
-        heartbeat_stale_trial_callback=optuna.storages.RetryHeartbeatStaleTrialCallback(
-            max_retry=1))
+
+    def make() -> Any:
+        return optuna.storages.RDBStorage(
+            url, heartbeat_interval=60, grace_period=600,
+            heartbeat_stale_trial_callback=optuna.storages.RetryHeartbeatStaleTrialCallback(
+                max_retry=1))
+
+    for attempt in range(2):  # workers started together race to create a new storage's tables
+        try:
+            return make()
+        except (IntegrityError, OperationalError):
+            time.sleep(1.0 + attempt)
+    return make()
 
 
 def load_study(name: str, url: str = DEFAULT_STORAGE) -> Any:
