@@ -277,6 +277,18 @@ def comparison_page() -> None:
              comparison_table(studies), ""]
     for png in sorted(folder.glob("*.png")):
         lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    floors = ROOT / "baselines" / "heuristics.json"
+    if floors.exists():
+        from baselines.evaluation import aggregate
+        from baselines.records import Study, from_json
+
+        studies = [aggregate(from_json(Study, d)) for d in load(floors)]
+        lines += ["## Heuristic floors", "",
+                  "Controllers a reader understands in one line (`baselines.heuristics`; "
+                  "[guide](../guide/baselines.md#heuristic-floors)), from "
+                  "`baselines/heuristics.json` (`python -m baselines.heuristics`): success "
+                  "from 20 starts per start perturbation and, in brackets, the time or effort "
+                  "over the optimum's, over the successes.", "", robustness_table(studies), ""]
     lines += ["## Shipped policies", "",
               "Every trained run in `baselines/trained/` (`STEM.json`: the exact arguments, "
               "versions and commit; `STEM.zip`: the model). Training success is over the last "
