@@ -8,11 +8,24 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 HISTORY = re.compile(
     r"\bsession[- ]\d+|\bissue[- ]?\d+|\bscratch (?:run|probe|measurement|launcher)s?\b"
-    r"|\bused to\b|\bnot kept\b|\bwork period|\bshipped before\b|\bbefore this (?:change|module)",
+    r"|\bused to (?:be|take|wait|run|give|reach|cost)\b|\bnot kept\b|\bwork period"
+    r"|\bshipped before\b|\bbefore this (?:change|module)",
     re.IGNORECASE)
 """Phrases that narrate how the code came to be rather than what it is."""
-CHECKED = ["README.md", "docs", "mdi_envs", "optimal"]
+CHECKED = ["README.md", "docs", "mdi_envs", "optimal", "baselines", "benchmarks", "tests"]
 """What is kept free of history (files and folders, recursively: .md and .py)."""
+SUB_READMES = ["optimal/README.md", "baselines/README.md", "benchmarks/README.md",
+               "mdi_envs/stepping/README.md", "baselines/search/README.md"]
+"""The folder maps beside the README."""
+
+
+def test_readmes_are_short() -> None:
+    """README.md at most 200 lines, each folder map at most 150, all together at most 800."""
+    lengths = {name: len((ROOT / name).read_text(encoding="utf-8").splitlines())
+               for name in ["README.md", *SUB_READMES]}
+    assert lengths["README.md"] <= 200, lengths
+    assert all(lengths[name] <= 150 for name in SUB_READMES), lengths
+    assert sum(lengths.values()) <= 800, lengths
 
 
 def _files() -> list[Path]:

@@ -18,10 +18,6 @@ def _section(title: str) -> str:
     return text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0]
 
 
-def test_readme_is_short() -> None:
-    assert len(README.read_text().splitlines()) <= 200
-
-
 def test_results_table_is_generated_from_the_comparison_json() -> None:
     sys.path.insert(0, str(ROOT / "docs"))
     try:

@@ -78,7 +78,7 @@ def test_ball_error_converges_at_first_order(quick: tuple[Path, dict[str, Any]])
 def test_ball_apex_error_at_1ms_meets_target_with_located_impacts(
     quick: tuple[Path, dict[str, Any]],
 ) -> None:
-    """Issue 7: "ball apex error <= 1e-3 relative at dt = 1e-3", converging at least O(dt).
+    """The target "ball apex error <= 1e-3 relative at dt = 1e-3", converging at least O(dt).
 
     Met by ``locate_impacts=True`` (what remains is the grid's sampling of each apex, ~g dt^2/8);
     the default midpoint step's O(v dt) error (~2.5e-3) is reported beside it as not met.
