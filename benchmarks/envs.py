@@ -18,11 +18,10 @@ from typing import Any
 
 import gymnasium as gym
 import numba
-import numpy as np
 
 import mdi_envs
 from benchmarks import report, timing
-from benchmarks.report import log_lines, plt, save_figure, summary
+from benchmarks.report import bars, log_lines, plt, save_figure, summary
 from benchmarks.timing import Progress, TimingPlan
 
 ACROBOT, MUJOCO_PEER = "Acrobot-v1", "InvertedDoublePendulum-v5"
@@ -403,41 +402,20 @@ def markdown_report(record: Mapping[str, Any]) -> str:
 def plot_step(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]],
               targets: Mapping[str, float], path: Path) -> None:
     """Bars of ``env.step`` µs per env (gym.make and unwrapped), with the targets as lines."""
-    labels = [short_name(r["env_id"]) + ("" if r["ours"] else "\n(peer)") for r in single]
-    labels += [short_name(u["env_id"]) + "\n(peer)" for u in unavailable]
-    x = np.arange(len(labels))
-    fig, ax = plt.subplots(figsize=(max(6.5, 1.6 * len(labels) + 2.0), 4.8))
-    width = 0.38
-    for offset, entry, color in ((-0.5, "gym.make", "tab:blue"), (0.5, "unwrapped", "tab:gray")):
-        med = [r[entry]["median_us"] for r in single]
-        err = [[r[entry]["median_us"] - r[entry]["q1_us"] for r in single],
-               [r[entry]["q3_us"] - r[entry]["median_us"] for r in single]]
-        colors = [color if entry != "gym.make" or r["ours"] else "tab:orange" for r in single]
-        bars = ax.bar(x[:len(single)] + offset * width, med, width, yerr=err, capsize=3,
-                      color=colors, label=f"env.step, {entry}" if entry == "unwrapped"
-                      else "env.step through gym.make (ours blue, peers orange)")
-        for bar, value in zip(bars, med, strict=True):
-            ax.text(bar.get_x() + bar.get_width() / 2, 0.6, f"{value:.1f}", ha="center",
-                    va="bottom", fontsize=7, color="white", fontweight="bold")
-    for i, item in enumerate(unavailable):
-        ax.text(len(single) + i, 1.0, "not measured:\n" + item["error"][:60].replace(": ", ":\n"),
-                ha="center", va="bottom", fontsize=6, color="tab:red")
-    ax.axhline(targets["manipulator_step_us"], color="tab:green", ls=":", lw=1.2,
+    labels = [short_name(r["env_id"]) + ("" if r["ours"] else " (peer)") for r in single]
+    labels += [f"{short_name(u['env_id'])} (peer, not measured: {u['error'][:40]})"
+               for u in unavailable]
+    fig, ax = plt.subplots(figsize=(8.5, 0.5 * len(labels) + 1.8))
+    ax.axvline(targets["manipulator_step_us"], color="tab:green", ls=":", lw=1.2,
                label=f"target: manipulator ≤ {targets['manipulator_step_us']:g} µs")
     acrobot = [r for r in single if r["env_id"] == "Acrobot-v1"]
     if acrobot:
         bound = acrobot[0]["gym.make"]["median_us"] / targets["speedup_vs_acrobot"]
-        ax.axhline(bound, color="tab:red", ls="--", lw=1.0,
-                   label=f"target: {targets['speedup_vs_acrobot']:g}× faster than Acrobot-v1 "
-                   f"(≤ {bound:.1f} µs)")
-    ax.set_yscale("log")
-    ax.set_ylim(bottom=0.5)
-    ax.set_xticks(x, labels, fontsize=8)
-    ax.set_ylabel("µs per env.step (median; bars: quartiles)")
-    ax.grid(True, axis="y", which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, frameon=False,
-              title="One environment: env.step time (lower is better)",
-              title_fontproperties={"size": 10})
+        ax.axvline(bound, color="tab:red", ls="--", lw=1.0, label=f"target: "
+                   f"{targets['speedup_vs_acrobot']:g}× faster than Acrobot-v1 (≤ {bound:.1f} µs)")
+    bars(ax, labels, {f"env.step, {entry}": [r[entry]["median_us"] for r in single]
+                      + [None] * len(unavailable) for entry in ("gym.make", "unwrapped")},
+         "µs per env.step (median)")
     save_figure(fig, path)
 
 
