@@ -526,33 +526,17 @@ def plot_single_step(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str
 
 
 def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
-    """Horizontal bars of the speedup off/on per shortcut measurement (log axis)."""
+    """Horizontal bars of the speedup off/on per shortcut (labels: on vs off µs per copy-step)."""
     fig, ax = plt.subplots(figsize=(8.5, 0.4 * max(len(shortcuts), 1) + 1.6))
-    if shortcuts:
-        labels = []
-        for r in shortcuts:
-            name = "no solve (free vs active)" if r["shortcut"] == "no_solve" else r["shortcut"]
-            scene = r["scene"] + ("" if r["off_scene"] == r["scene"] else f" vs {r['off_scene']}")
-            labels.append(f"{name}: {r['model']} / {scene}")
-        y = np.arange(len(shortcuts))
-        speedups = [r["speedup"] for r in shortcuts]
-        colors = ["tab:gray" if r["shortcut"] == "no_solve" else "tab:blue" for r in shortcuts]
-        fastest = [r["speedup_fastest_rounds"] for r in shortcuts]
-        ax.barh(y, speedups, 0.6, color=colors, label="ratio of medians")
-        ax.plot(fastest, y, "kD", ms=4, label="ratio of fastest rounds")
-        for yi, r in zip(y, shortcuts, strict=True):
-            ax.text(max(r["speedup"], r["speedup_fastest_rounds"]), yi,
-                    f"  {format_us(r['on']['per_copy_step_s'])} vs "
-                    f"{format_us(r['off']['per_copy_step_s'])} µs", va="center", fontsize=7)
-        ax.set_yticks(y, labels, fontsize=8)
-        ax.invert_yaxis()
-        ax.set_xlim(0.0, 1.25 * max(max(speedups), max(fastest), 1.0))
-        ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2,
-                  frameon=False)
     ax.axvline(1.0, color="k", lw=0.8)
-    ax.set_xlabel("time off / time on (> 1: the shortcut saves time)\n"
-                  "labels: on vs off, µs per copy-step (medians)")
-    ax.grid(True, axis="x", which="both", alpha=0.3)
+    labels = [f"{'no solve (free vs active)' if r['shortcut'] == 'no_solve' else r['shortcut']}: "
+              f"{r['model']} / {r['scene']}" + ("" if r["off_scene"] == r["scene"]
+                                                else f" vs {r['off_scene']}") + " ("
+              f"{format_us(r['on']['per_copy_step_s'])} vs "
+              f"{format_us(r['off']['per_copy_step_s'])} µs)" for r in shortcuts]
+    bars(ax, labels, {"ratio of medians": [r["speedup"] for r in shortcuts],
+                      "ratio of fastest rounds": [r["speedup_fastest_rounds"] for r in shortcuts]},
+         "time off / time on (> 1: the shortcut saves time)")
     save_figure(fig, path)
 
 
