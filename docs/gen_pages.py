@@ -385,19 +385,59 @@ def references_page() -> None:
     write("results/references.md", "\n".join(lines))
 
 
+def search_page() -> None:
+    """``results/search.md``: the Optuna studies of ``baselines/search/studies.db`` and plots."""
+    import shutil
+    import tempfile
+    import warnings
+
+    import optuna
+
+    from baselines.search import summary
+
+    folder = ROOT / "baselines" / "search"
+    lines = ["# Hyperparameter search", "",
+             "Generated from `baselines/search/studies.db` (Optuna; written by "
+             "`python -m baselines.search run STUDY`, plots by `python -m baselines.search plot "
+             "STUDY`). A trial's score is the success rate from 20 starts perturbed at 0.1, "
+             "then the time or effort ratio ([method](../guide/baselines.md#hyperparameter-"
+             "search)).", ""]
+    with tempfile.TemporaryDirectory() as scratch, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        optuna.logging.set_verbosity(optuna.logging.WARNING)
+        copy = Path(scratch) / "studies.db"  # read a copy: the build never writes the repo
+        shutil.copy(folder / "studies.db", copy)
+        url = f"sqlite:///{copy}"
+        for study in optuna.get_all_study_summaries(url):
+            result = summary(study.study_name, url)
+            lines += [f"## {study.study_name}", "",
+                      table([{"trials " + k.lower(): v for k, v in result["trials"].items()}
+                             | {"best trial": result.get("best_trial"),
+                                "best score": result.get("best_score")}]), ""]
+            if "best_params" in result:
+                lines += ["Best trial's evaluation and settings:", "",
+                          table([result["best_evaluation"]]), "",
+                          table([result["best_params"]]), ""]
+            for png in sorted(folder.glob(f"{study.study_name}_*.png")):
+                lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    write("results/search.md", "\n".join(lines))
+
+
 def results_pages() -> None:
-    """Every results page and its nav entries."""
-    write("results/index.md", "# Results\n\nEvery table on these pages is generated at build "
-          "time from the committed JSON; every figure is a committed PNG.\n\n"
-          "* [RL vs MPC vs optimal](comparison.md)\n* [Robustness](robustness.md)\n"
-          "* [Optimal references](references.md)\n* [Benchmarks](benchmarks.md)\n")
+    """Every results page, its index and its nav entries."""
+    pages = {"comparison": "RL vs MPC vs optimal", "robustness": "Robustness",
+             "references": "Optimal references", "benchmarks": "Benchmarks"}
     comparison_page()
     robustness_page()
     references_page()
     benchmark_page()
-    write("results/SUMMARY.md", "* [Results](index.md)\n* [RL vs MPC vs optimal](comparison.md)\n"
-          "* [Robustness](robustness.md)\n* [Optimal references](references.md)\n"
-          "* [Benchmarks](benchmarks.md)\n")
+    if (ROOT / "baselines" / "search" / "studies.db").exists():
+        search_page()
+        pages["search"] = "Hyperparameter search"
+    links = "".join(f"* [{title}]({page}.md)\n" for page, title in pages.items())
+    write("results/index.md", "# Results\n\nEvery table on these pages is generated at build "
+          "time from the committed results; every figure is a committed PNG.\n\n" + links)
+    write("results/SUMMARY.md", "* [Results](index.md)\n" + links)
 
 
 # --- API reference ----------------------------------------------------------------------------
