@@ -62,6 +62,72 @@ _INFO_TYPES: dict[str, Any] = {
 }
 
 
+class EnvSettings(NamedTuple):
+    """What the compiled env step reads of a scene besides its state, the model's parameter
+    record and the scene constants (all three stored as float64 at the end of every
+    ``BatchState`` buffer and rebuilt inside the kernels, see ``_reader``).
+
+    Attributes:
+        time_step: physics step [s].
+        frame_skip: physics steps per env step.
+        dt: env step [s] (time_step * frame_skip).
+        horizon_steps: env steps of the fixed horizon of the "effort" objective (0: "time").
+        effort_weight, goal_weight, shaping_weight, shaping_discount: the reward's weights and
+            the shaping discount gamma (see the module docstring).
+        action_rule: how the brake level is decoded (``TorqueBrakeActions.rule``).
+        max_torque: bound of every input at level 1 [N m or N].
+        max_brake_torque: the Tresca bound at brake level 1 of "brake_force" [N m].
+    """
+
+    time_step: float
+    frame_skip: int
+    dt: float
+    horizon_steps: int
+    effort_weight: float
+    goal_weight: float
+    shaping_weight: float
+    shaping_discount: float
+    action_rule: int
+    max_torque: float
+    max_brake_torque: float
+
+
+class SceneKernels(NamedTuple):
+    """The compiled kernels of one scene class (see ``_compiled``)."""
+
+    advance: Any
+    observe_all: Any
+    distance_one: Any
+    restart: Any
+
+
+class StateViews(NamedTuple):
+    """The named views of a ``BatchState`` buffer, in buffer order (see ``_state_carver``).
+
+    ``workspace_floats``/``workspace_ints``: the stepper's scratch; ``q`` to ``reward``: the
+    per-copy arrays of ``state_fields``; ``obs``: the float32 observations; ``settings``: the
+    ``EnvSettings``, the parameter record and the scene constants, as float64.
+    """
+
+    workspace_floats: Any
+    workspace_ints: Any
+    q: Any
+    u: Any
+    tau: Any
+    brake: Any
+    impulses: Any
+    step_impulses: Any
+    physics: Any
+    info: Any
+    elapsed_steps: Any
+    effort: Any
+    potential: Any
+    terminated: Any
+    reward: Any
+    obs: Any
+    settings: Any
+
+
 def _require(condition: bool, message: str) -> None:
     if not condition:
         raise ValueError(message)
@@ -82,11 +148,12 @@ def build_parameters(parameters: Any, defaults: type[Any], **overrides: Any) -> 
 class MoreauJeanScene:
     """Scene logic of one environment family, batched over N copies.
 
-    Subclasses set ``MODEL``, ``NUM_OBSERVATIONS`` and ``OBJECTIVE_OPTIONS``, the action coding
-    ``actions`` with ``single_action_space = actions.space()``, the observation space, and
-    implement the compiled ``observe_one``, ``distance_one`` and ``success_one`` with their
-    ``constants``, plus ``nominal_start`` with ``START_NOISE_ENTRIES`` and ``info_one`` with
-    ``INFO_KEYS``. Arrays are float64 of shape (N, ...), observations float32.
+    Subclasses set ``MODEL``, ``NUM_OBSERVATIONS``, ``OBJECTIVE_OPTIONS`` and ``CONSTANTS``,
+    the action coding ``actions`` with ``single_action_space = actions.space()``, the
+    observation space, and implement the compiled ``observe_one``, ``distance_one`` and
+    ``success_one`` with the ``constants`` record ``c`` they read, plus ``nominal_start`` with
+    ``START_NOISE_ENTRIES`` and ``info_one`` with ``INFO_KEYS``. Arrays are float64 of shape
+    (N, ...), observations float32.
 
     Args:
         parameters: the model's parameter dataclass (default: its defaults).
@@ -128,6 +195,7 @@ class MoreauJeanScene:
         locate_impacts: bool = False,
     ) -> None:
         self._settings_cache: FloatArray | None = None
+        self._constants_cache: Any = None
         self._info_keys = BASE_INFO_KEYS + self.INFO_KEYS
         self._info_of = _info_builder(self._info_keys)
         _require(isinstance(frame_skip, (int, np.integer)) and frame_skip >= 1,
@@ -164,7 +232,7 @@ class MoreauJeanScene:
     def _take_kernels(self) -> None:
         """Look up (or build) the compiled kernels of this scene (see ``_compiled``)."""
         self._kernels = _compiled(self)
-        self._advance_kernel = self._kernels[0]
+        self._advance_kernel = self._kernels.advance
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle without the compiled kernels and the info builder (rebuilt when unpickled)."""
@@ -177,32 +245,37 @@ class MoreauJeanScene:
         self._take_kernels()
 
     @property
-    def _settings_array(self) -> FloatArray:
-        """Everything the compiled ``advance`` reads of the scene, in one float64 array (copied
-        to the end of every ``BatchState`` buffer).
+    def settings(self) -> EnvSettings:
+        """What the compiled step reads of the scene (``EnvSettings``)."""
+        coding = self.actions
+        return EnvSettings(
+            self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
+            self.effort_weight, self.goal_weight, self.shaping_weight, self.shaping_discount,
+            coding.rule, coding.max_torque, coding.max_brake_torque,
+        )  # fmt: skip
 
-        (time_step, frame_skip, dt, horizon steps, effort_weight, goal_weight, shaping_weight,
-        shaping_discount, action rule, max_torque, max_brake_torque), then the model's
-        parameter record, then the scene constants ``c`` (see ``_compiled``).
+    @property
+    def _settings_array(self) -> FloatArray:
+        """``settings``, the model's parameter record and ``constants()``, in one float64 array
+        (copied to the end of every ``BatchState`` buffer; read back by ``_reader``).
         """
         if self._settings_cache is None:
-            coding = self.actions
-            self._settings_cache = np.array([
-                self.stepper.time_step, self.frame_skip, self.dt, self.num_horizon_steps,
-                self.effort_weight, self.goal_weight, self.shaping_weight,
-                self.shaping_discount, coding.rule, coding.max_torque, coding.max_brake_torque,
-                *self.stepper.compiled_step_batch[1], *np.asarray(self.constants(), np.float64),
-            ])  # fmt: skip
+            self._settings_cache = np.array(
+                [*self.settings, *self.stepper.compiled_step_batch[1], *self._constants],
+                np.float64)  # fmt: skip
         return self._settings_cache
 
     @property
-    def _constants(self) -> FloatArray:
-        """The scene constants ``c`` (a view into ``_settings_array``)."""
-        return self._settings_array[SETTINGS_SIZE + len(self.stepper.compiled_step_batch[1]):]
+    def _constants(self) -> Any:
+        """``constants()``, built once."""
+        if self._constants_cache is None:
+            self._constants_cache = self.constants()
+        return self._constants_cache
 
     # -- scene-specific, implemented by each scene class ------------------------------------
-    # The three static methods below are compiled by numba (nopython): plain arithmetic on
-    # floats and 1-D float64 arrays, scene constants read from ``c`` (``self.constants()``).
+    # The static methods below are compiled by numba (nopython): plain arithmetic on floats
+    # and 1-D float64 arrays, scene constants read by name from the record ``c``
+    # (``self.constants()``).
     NUM_OBSERVATIONS: ClassVar[int]
 
     @staticmethod
@@ -220,8 +293,12 @@ class MoreauJeanScene:
         """Whether one copy is at the goal at rest within the maneuver's tolerances."""
         raise NotImplementedError
 
-    def constants(self) -> FloatArray:
-        """The scene constants ``c`` read by the compiled functions, float64 (any length)."""
+    CONSTANTS: ClassVar[type[Any]]
+    """The NamedTuple class of ``constants()`` (floats; defined at module level, where the
+    kernel cache imports it)."""
+
+    def constants(self) -> Any:
+        """The scene constants ``c`` the compiled functions read by name (a ``CONSTANTS``)."""
         raise NotImplementedError
 
     START_NOISE_ENTRIES: ClassVar[tuple[int, ...]]
@@ -296,7 +373,7 @@ class MoreauJeanScene:
 
     def observe(self, state: BatchState) -> Any:
         """Recompute every copy's observation into ``state.obs`` and return it."""
-        observe_all = self._kernels[1]
+        observe_all = self._kernels.observe_all
         observe_all(state.q, state.u, state.brake, state.elapsed_steps, self.num_horizon_steps,
                     self.dt, self._constants, state.obs)
         return state.obs
@@ -325,11 +402,11 @@ class MoreauJeanScene:
         n = self.MODEL.NUM_DOFS
         state.q[indices] = starts[:, :n]
         state.u[indices] = starts[:, n:]
-        self._kernels[3](indices, state.buffer)
+        self._kernels.restart(indices, state.buffer)
 
     def update_potential(self, state: BatchState, index: int) -> None:
         """Phi of copy ``index`` after its state was set from outside the step."""
-        distance = self._kernels[2](state.q[index], state.u[index], self._constants)
+        distance = self._kernels.distance_one(state.q[index], state.u[index], self._constants)
         state.potential[index] = -self.shaping_weight * distance
 
 
@@ -637,18 +714,15 @@ class MoreauJeanVectorEnv(VectorEnv[Any, Any, Any]):
         return self.state.obs.copy(), reward, terminated, truncated, infos
 
 
-_COMPILED: dict[tuple[Any, ...], tuple[Any, Any, Any, Any]] = {}
+_COMPILED: dict[tuple[Any, ...], SceneKernels] = {}
 _FIRST_COPY = np.zeros(1, np.int64)
-SETTINGS_SIZE = 11
-"""Entries of ``MoreauJeanScene._settings_array`` before the model's parameter record."""
 ADVANCE_OK, ADVANCE_ACTION_NOT_FINITE, ADVANCE_STATE_NOT_FINITE, ADVANCE_ACTION_SHAPE = 0, 1, 2, 3
 """Outcomes of the compiled ``advance``."""
 
 
 def _state_carver(layout: StateLayout) -> tuple[tuple[str, ...], Any, Any]:
-    """(names, carve, compiled carve): ``carve(buffer)`` returns the named views of a
-    ``BatchState`` buffer, in order, from numpy arrays; the compiled one (inlined) inside the
-    kernels.
+    """(names, carve, compiled carve): ``carve(buffer)`` returns the ``StateViews`` of a
+    ``BatchState`` buffer from numpy arrays; the compiled one (inlined) inside the kernels.
 
     One generated source serves both, so the kernels and ``BatchState`` read the same layout;
     every width is a compile-time constant. Cached per layout.
@@ -671,8 +745,10 @@ def _state_carver(layout: StateLayout) -> tuple[tuple[str, ...], Any, Any]:
                   f"    settings = buffer[{start} + (N * {k} + 1) // 2:]"]
         names = ("workspace_floats", "workspace_ints", *(name for name, _ in layout.fields),
                  "obs", "settings")
-        lines.append(f"    return ({', '.join(names)},)")
-        namespace: dict[str, Any] = {"np": np}
+        if names != StateViews._fields:
+            raise ValueError(f"state fields {names} differ from StateViews {StateViews._fields}")
+        lines.append(f"    return StateViews({', '.join(names)})")
+        namespace: dict[str, Any] = {"np": np, "StateViews": StateViews}
         define("\n".join(lines), namespace)
         carve = namespace["carve"]
         _CARVERS[layout] = (names, carve, njit(inline="always")(carve))
@@ -705,30 +781,53 @@ def _info_builder(keys: tuple[str, ...]) -> Any:
 _INFO_BUILDERS: dict[tuple[str, ...], Any] = {}
 
 
-def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
-    """The batched kernels of ``scene``: compiled once per scene class, stepper kernel, parameter
-    record type and state layout, per process.
+def _reader(record_type: type[Any], start: int) -> Any:
+    """A compiled, inlined ``read(settings)``: the ``record_type`` (a NamedTuple) rebuilt from
+    the float64 entries ``settings[start:start + len(fields)]``, its ``int`` fields converted.
 
-    Returns (advance, observe_all, distance_one, restart). ``advance(levels, buffer)`` checks
-    the levels' size and rank, decodes the actions, runs the physics substeps and then the
-    rewards, observations and info of every copy in one compiled call (one dispatch from Python
-    per env step), and returns an ``ADVANCE_*`` outcome. Its arguments are two arrays (each
-    costs about 0.1 us to type per call, a tuple several): everything else is carved from the
-    ``BatchState`` buffer inside, the parameter record rebuilt from its settings. The loop
-    over the copies after the physics (``evaluate``) takes row views of every copy and is
-    compiled without reference counting (``mdi_envs._borrowing``).
+    The kernels read their ``EnvSettings``, parameter record and scene constants by name this
+    way, from the end of the ``BatchState`` buffer, at no cost per step (the record is a value
+    numba keeps in registers). Cached per (type, start).
+    """
+    key = (record_type, start)
+    if key not in _READERS:
+        hints = getattr(record_type, "__annotations__", {})
+        entries = ", ".join(
+            f"int(settings[{start + k}])" if hints.get(name) in (int, "int")
+            else f"settings[{start + k}]"
+            for k, name in enumerate(record_type._fields))  # type: ignore[attr-defined]
+        namespace: dict[str, Any] = {"Record": record_type}
+        define(f"def read(settings):\n    return Record({entries})", namespace)
+        _READERS[key] = njit(inline="always")(namespace["read"])
+    return _READERS[key]
+
+
+_READERS: dict[tuple[type[Any], int], Any] = {}
+
+
+def _compiled(scene: MoreauJeanScene) -> SceneKernels:
+    """The batched kernels of ``scene``: compiled once per scene class, stepper kernel,
+    parameter record type and state layout, per process.
+
+    ``advance(levels, buffer)`` checks the levels' size and rank, decodes the actions, runs the
+    physics substeps and then the rewards, observations and info of every copy in one compiled
+    call (one dispatch from Python per env step), and returns an ``ADVANCE_*`` outcome. Its
+    arguments are two arrays (each costs about 0.1 us to type per call, a tuple several):
+    everything else is carved from the ``BatchState`` buffer inside (``StateViews``), the
+    ``EnvSettings``, parameter record and scene constants rebuilt from its settings
+    (``_reader``). The loop over the copies after the physics (``evaluate``) takes row views of
+    every copy and is compiled without reference counting (``mdi_envs._borrowing``).
     """
     step_batch, record = scene.stepper.compiled_step_batch[:2]
+    constants_type = scene.CONSTANTS
     layout = StateLayout.of(scene)
-    key = (type(scene), step_batch, type(record), layout)
+    key = (type(scene), step_batch, type(record), constants_type, layout)
     if key in _COMPILED:
         return _COMPILED[key]
-    record_entries = ", ".join(f"settings[{SETTINGS_SIZE + i}]" for i in range(len(record)))
-    namespace: dict[str, Any] = {"Record": type(record)}
-    define(f"def read_record(settings):\n    return Record({record_entries})", namespace)
-    read_record = njit(inline="always")(namespace["read_record"])
+    read_settings = _reader(EnvSettings, 0)
+    read_record = _reader(type(record), len(EnvSettings._fields))
+    read_constants = _reader(constants_type, len(EnvSettings._fields) + len(record))
     carve_state = _state_carver(layout)[2]
-    constants_start = SETTINGS_SIZE + len(record)
     num_torques = scene.MODEL.NUM_INPUTS
     width = num_torques + scene.MODEL.NUM_BRAKES  # of one copy's levels
     # inlined into ``evaluate``: no call per copy, and one copy's array views stay local
@@ -738,10 +837,10 @@ def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
     info_one = njit(inline="always")(scene.info_one)
 
     @borrowing_njit
-    def evaluate(q, u, tau, brake, impulses, physics, c, dt, horizon, effort_weight,  # noqa: ANN001
-                 goal_weight, shaping_weight, discount, elapsed, effort, potential, terminated,
-                 reward, obs, info):
+    def evaluate(q, u, tau, brake, impulses, physics, c, s, elapsed, effort, potential,  # noqa: ANN001
+                 terminated, reward, obs, info):
         finite = True
+        dt, horizon = s.dt, s.horizon_steps
         for i in range(q.shape[0]):
             qi, ui, bi, row = q[i], u[i], brake[i], info[i]
             for j in range(q.shape[1]):
@@ -753,17 +852,17 @@ def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
                 rate += tau[i, j] * tau[i, j]
             effort[i] += rate * dt
             d = distance_one(qi, ui, c)
-            s = success_one(qi, ui, c)
+            success = success_one(qi, ui, c)
             if horizon == 0:  # objective "time": success ends the episode
                 objective = -dt
-                ended = s
+                ended = success
                 goal = 0.0
             else:  # objective "effort" over a fixed horizon
-                objective = -effort_weight * rate * dt
+                objective = -s.effort_weight * rate * dt
                 ended = elapsed[i] >= horizon
-                goal = -goal_weight * d if ended else 0.0
-            phi = 0.0 if ended else -shaping_weight * d
-            shaping = discount * phi - potential[i]
+                goal = -s.goal_weight * d if ended else 0.0
+            phi = 0.0 if ended else -s.shaping_weight * d
+            shaping = s.shaping_discount * phi - potential[i]
             potential[i] = phi
             reward[i] = objective + shaping + goal
             terminated[i] = 1.0 if ended else 0.0
@@ -772,7 +871,7 @@ def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
             row[1] = shaping
             row[2] = goal
             row[3] = d
-            row[4] = 1.0 if s else 0.0
+            row[4] = 1.0 if success else 0.0
             row[5] = elapsed[i] * dt
             row[6] = effort[i]
             row[7] = physics[i, INFO_STATUS]
@@ -785,28 +884,28 @@ def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
 
     @njit
     def advance(levels, buffer):  # noqa: ANN001
-        (workspace_floats, workspace_ints, q, u, tau, brake, impulses, step_impulses, physics,
-         info, elapsed, effort, potential, terminated, reward, obs, settings) = carve_state(buffer)
-        if levels.ndim > 2 or levels.size != width * q.shape[0]:
+        v = carve_state(buffer)
+        if levels.ndim > 2 or levels.size != width * v.q.shape[0]:
             return ADVANCE_ACTION_SHAPE
-        if not decode_levels(levels, num_torques, int(settings[8]), settings[9], settings[10],
-                             tau, brake):  # fmt: skip
+        s = read_settings(v.settings)
+        if not decode_levels(levels, num_torques, s.action_rule, s.max_torque,
+                             s.max_brake_torque, v.tau, v.brake):  # fmt: skip
             return ADVANCE_ACTION_NOT_FINITE
         # one physics step at a time, to sum each copy's impulses over the env step
-        record = read_record(settings)
-        worst = np.zeros(q.shape[0])
+        record = read_record(v.settings)
+        worst = np.zeros(v.q.shape[0])
+        step_impulses = v.step_impulses
         step_impulses[:] = 0.0
-        for _ in range(int(settings[1])):
-            step_batch(q, u, tau, brake, settings[0], record, 1, impulses, physics,
-                       (workspace_floats, workspace_ints))  # fmt: skip
-            step_impulses += impulses
-            for i in range(q.shape[0]):
-                worst[i] = max(worst[i], physics[i, INFO_STATUS])
-        physics[:, INFO_STATUS] = worst
-        finite = evaluate(q, u, tau, brake, step_impulses, physics, settings[constants_start:],
-                          settings[2], int(settings[3]), settings[4], settings[5], settings[6],
-                          settings[7], elapsed, effort, potential, terminated, reward, obs,
-                          info)  # fmt: skip
+        for _ in range(s.frame_skip):
+            step_batch(v.q, v.u, v.tau, v.brake, s.time_step, record, 1, v.impulses, v.physics,
+                       (v.workspace_floats, v.workspace_ints))  # fmt: skip
+            step_impulses += v.impulses
+            for i in range(v.q.shape[0]):
+                worst[i] = max(worst[i], v.physics[i, INFO_STATUS])
+        v.physics[:, INFO_STATUS] = worst
+        finite = evaluate(v.q, v.u, v.tau, v.brake, step_impulses, v.physics,
+                          read_constants(v.settings), s, v.elapsed_steps, v.effort, v.potential,
+                          v.terminated, v.reward, v.obs, v.info)  # fmt: skip
         return ADVANCE_OK if finite else ADVANCE_STATE_NOT_FINITE
 
     @njit
@@ -820,27 +919,33 @@ def _compiled(scene: MoreauJeanScene) -> tuple[Any, Any, Any, Any]:
         """Zero the episode state of the copies ``indices`` (q, u already set), then their
         Phi and observation (see ``MoreauJeanScene.reset_copies``).
         """
-        (_, _, q, u, tau, brake, impulses, step_impulses, _, _, elapsed, effort, potential,
-         terminated, _, obs, settings) = carve_state(buffer)
-        c = settings[constants_start:]
-        horizon, dt, shaping_weight = settings[3], settings[2], settings[6]
+        v = carve_state(buffer)
+        s = read_settings(v.settings)
+        c = read_constants(v.settings)
         for i in indices:
-            tau[i, :] = 0.0
-            brake[i, :] = 0.0
-            impulses[i, :] = 0.0
-            step_impulses[i, :] = 0.0
-            elapsed[i] = 0.0
-            effort[i] = 0.0
-            terminated[i] = 0.0
-            potential[i] = -shaping_weight * distance_one(q[i], u[i], c)
-            observe_one(q[i], u[i], brake[i], horizon * dt, c, obs[i])
+            v.tau[i, :] = 0.0
+            v.brake[i, :] = 0.0
+            v.impulses[i, :] = 0.0
+            v.step_impulses[i, :] = 0.0
+            v.elapsed_steps[i] = 0.0
+            v.effort[i] = 0.0
+            v.terminated[i] = 0.0
+            v.potential[i] = -s.shaping_weight * distance_one(v.q[i], v.u[i], c)
+            observe_one(v.q[i], v.u[i], v.brake[i], s.horizon_steps * s.dt, c, v.obs[i])
 
     frozen = freeze(f"scene_{type(scene).__name__}",
                     {"advance": advance, "observe_all": observe_all,
                      "distance_one": distance_one, "restart": restart})
-    _COMPILED[key] = (frozen["advance"], frozen["observe_all"], frozen["distance_one"],
-                      frozen["restart"])
+    _COMPILED[key] = SceneKernels(**frozen)
     return _COMPILED[key]
 
 
-__all__ = ["BatchState", "MoreauJeanEnv", "MoreauJeanScene", "MoreauJeanVectorEnv"]
+__all__ = [
+    "BatchState",
+    "EnvSettings",
+    "MoreauJeanEnv",
+    "MoreauJeanScene",
+    "MoreauJeanVectorEnv",
+    "SceneKernels",
+    "StateViews",
+]

@@ -5,7 +5,7 @@ two-link arm with a motor on the first joint and an impulsive brake on the secon
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from gymnasium import spaces
@@ -21,11 +21,29 @@ from mdi_envs.mechanics.parameters import require_positive
 VELOCITY_WEIGHT = 0.3  # [s] weight of the speeds in the goal distance (rad/s -> rad)
 
 
+class BlockableManipulatorConstants(NamedTuple):
+    """What the compiled scene functions read (``c``).
+
+    Attributes:
+        goal_alpha, goal_beta: goal angles [rad]. angle_tolerance [rad], speed_tolerance
+        [rad/s]: the success box. velocity_weight: of the speeds in the distance [s].
+        max_brake_torque: the brake bound at level 1 [N m] (scales the observed level).
+    """
+
+    goal_alpha: float
+    goal_beta: float
+    angle_tolerance: float
+    speed_tolerance: float
+    velocity_weight: float
+    max_brake_torque: float
+
+
 class BlockableManipulatorScene(MoreauJeanScene):
     """Batched logic of the manipulator environments (documented on the env class)."""
 
     MODEL = BlockableManipulator
     NUM_OBSERVATIONS = 7
+    CONSTANTS = BlockableManipulatorConstants
 
     def __init__(
         self,
@@ -57,11 +75,12 @@ class BlockableManipulatorScene(MoreauJeanScene):
         """Rest at alpha = beta = 0."""
         return np.array([*MANIPULATOR_MANEUVER.initial_q, 0.0, 0.0])
 
-    def constants(self) -> FloatArray:
-        """(goal alpha, goal beta, angle tol, speed tol, velocity weight, max brake torque)."""
+    def constants(self) -> BlockableManipulatorConstants:
+        """The maneuver's goal and tolerances, the distance weight, the brake bound."""
         maneuver = MANIPULATOR_MANEUVER
-        return np.array([*maneuver.goal_q, maneuver.angle_tolerance, maneuver.velocity_tolerance,
-                         VELOCITY_WEIGHT, self.max_brake_torque])  # fmt: skip
+        return BlockableManipulatorConstants(*maneuver.goal_q, maneuver.angle_tolerance,
+                                             maneuver.velocity_tolerance, VELOCITY_WEIGHT,
+                                             self.max_brake_torque)  # fmt: skip
 
     @staticmethod
     def observe_one(q: Any, u: Any, brake: Any, time_left: float, c: Any, out: Any) -> None:
@@ -70,21 +89,23 @@ class BlockableManipulatorScene(MoreauJeanScene):
         out[2], out[3] = cos_sin(q[1])
         out[4] = u[0]
         out[5] = u[1]
-        out[6] = min(brake[0] / c[5], 1.0)
+        out[6] = min(brake[0] / c.max_brake_torque, 1.0)
 
     @staticmethod
     def distance_one(q: Any, u: Any, c: Any) -> float:
         """sqrt(e_a^2 + e_b^2 + w^2 (a'^2 + b'^2)), wrapped angle errors e, w = 0.3 s."""
-        e0 = wrap_angle(q[0] - c[0])
-        e1 = wrap_angle(q[1] - c[1])
-        return math.sqrt(e0 * e0 + e1 * e1 + c[4] * c[4] * (u[0] * u[0] + u[1] * u[1]))
+        e0 = wrap_angle(q[0] - c.goal_alpha)
+        e1 = wrap_angle(q[1] - c.goal_beta)
+        w = c.velocity_weight
+        return math.sqrt(e0 * e0 + e1 * e1 + w * w * (u[0] * u[0] + u[1] * u[1]))
 
     @staticmethod
     def success_one(q: Any, u: Any, c: Any) -> bool:
         """Both wrapped angle errors <= angle tol and both speeds <= speed tol."""
-        e0 = wrap_angle(q[0] - c[0])
-        e1 = wrap_angle(q[1] - c[1])
-        return (max(abs(e0), abs(e1)) <= c[2]) and (max(abs(u[0]), abs(u[1])) <= c[3])
+        e0 = wrap_angle(q[0] - c.goal_alpha)
+        e1 = wrap_angle(q[1] - c.goal_beta)
+        return (max(abs(e0), abs(e1)) <= c.angle_tolerance
+                and max(abs(u[0]), abs(u[1])) <= c.speed_tolerance)
 
     INFO_KEYS = ("brake_engaged", "brake_impulse")
 

@@ -5,7 +5,7 @@ rest in finitely many impacts (Zeno) while a bounded horizontal force carries it
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from gymnasium import spaces
@@ -29,11 +29,30 @@ GAP_TOLERANCE = 1e-3  # [m] |y - r| at success
 VELOCITY_WEIGHT = 0.3  # [s] weight of the horizontal speed in the goal distance
 
 
+class BouncingBallConstants(NamedTuple):
+    """What the compiled scene functions read (``c``).
+
+    Attributes:
+        goal_x [m], radius [m], gravity [m/s^2]; position_tolerance [m], speed_tolerance
+        [m/s], gap_tolerance [m]: the success box; velocity_weight [s]: of the horizontal speed
+        in the distance.
+    """
+
+    goal_x: float
+    radius: float
+    gravity: float
+    position_tolerance: float
+    speed_tolerance: float
+    gap_tolerance: float
+    velocity_weight: float
+
+
 class BouncingBallScene(MoreauJeanScene):
     """Batched logic of the bouncing-ball environments (documented on the env class)."""
 
     MODEL = BouncingBall
     NUM_OBSERVATIONS = 4
+    CONSTANTS = BouncingBallConstants
     INFO_KEYS = ("normal_impulse", "friction_impulse", "penetration")
 
     def __init__(
@@ -69,17 +88,17 @@ class BouncingBallScene(MoreauJeanScene):
         """Rest at (0, 1 m)."""
         return np.array([0.0, INITIAL_HEIGHT, 0.0, 0.0])
 
-    def constants(self) -> FloatArray:
-        """(goal x, radius, gravity, position tol, speed tol, gap tol, velocity weight)."""
+    def constants(self) -> BouncingBallConstants:
+        """The goal, the ball's radius and gravity, the tolerances, the distance weight."""
         p = self.parameters
-        return np.array([GOAL_X, p.radius, p.gravity, POSITION_TOLERANCE, SPEED_TOLERANCE,
-                         GAP_TOLERANCE, VELOCITY_WEIGHT])  # fmt: skip
+        return BouncingBallConstants(GOAL_X, p.radius, p.gravity, POSITION_TOLERANCE,
+                                     SPEED_TOLERANCE, GAP_TOLERANCE, VELOCITY_WEIGHT)
 
     @staticmethod
     def observe_one(q: Any, u: Any, brake: Any, time_left: float, c: Any, out: Any) -> None:
         """(x - goal, gap y - r, x', y')."""
-        out[0] = q[0] - c[0]
-        out[1] = q[1] - c[1]
+        out[0] = q[0] - c.goal_x
+        out[1] = q[1] - c.radius
         out[2] = u[0]
         out[3] = u[1]
 
@@ -90,22 +109,23 @@ class BouncingBallScene(MoreauJeanScene):
         h = max(gap, 0) + y'^2 / (2 g): the height of the next apex above contact (the vertical
         energy over m g).
         """
-        e_x = q[0] - c[0]
-        h = max(q[1] - c[1], 0.0)
-        if c[2] > 0.0:
-            h += u[1] * u[1] / (2.0 * c[2])
+        e_x = q[0] - c.goal_x
+        h = max(q[1] - c.radius, 0.0)
+        w = c.velocity_weight
+        if c.gravity > 0.0:
+            h += u[1] * u[1] / (2.0 * c.gravity)
         else:
-            h += c[6] * abs(u[1])
-        return math.sqrt(e_x * e_x + c[6] * c[6] * u[0] * u[0] + h * h)
+            h += w * abs(u[1])
+        return math.sqrt(e_x * e_x + w * w * u[0] * u[0] + h * h)
 
     @staticmethod
     def success_one(q: Any, u: Any, c: Any) -> bool:
         """|x - goal| <= 0.02 m, |x'| <= 0.05 m/s, |y - r| <= 1e-3 m, |y'| <= 0.05 m/s."""
         return (
-            abs(q[0] - c[0]) <= c[3]
-            and abs(u[0]) <= c[4]
-            and abs(q[1] - c[1]) <= c[5]
-            and abs(u[1]) <= c[4]
+            abs(q[0] - c.goal_x) <= c.position_tolerance
+            and abs(u[0]) <= c.speed_tolerance
+            and abs(q[1] - c.radius) <= c.gap_tolerance
+            and abs(u[1]) <= c.speed_tolerance
         )
 
     @staticmethod
@@ -114,7 +134,7 @@ class BouncingBallScene(MoreauJeanScene):
         """P_N and P_T of the last physics step [N s]; penetration max(0, r - y) [m]."""
         out[0] = impulses[0]
         out[1] = impulses[1]
-        out[2] = max(c[1] - q[1], 0.0)
+        out[2] = max(c.radius - q[1], 0.0)
 
 
 class BouncingBallEnv(MoreauJeanEnv):

@@ -6,7 +6,7 @@ stick-slip ground contacts, to a goal pose fastest ("time") or with least effort
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from gymnasium import spaces
@@ -26,11 +26,34 @@ YAW_RATE_WEIGHT = 0.25  # [m s/rad] weight of the yaw rate in the goal distance
 SLIDING_SPEED = 1e-4  # [m/s] a contact is drawn as sliding above this slip speed
 
 
+class DiffDriveRobotConstants(NamedTuple):
+    """What the compiled scene functions read (``c``).
+
+    Attributes:
+        goal_x, goal_y [m], goal_phi [rad]: the goal pose. position_tolerance [m],
+        heading_tolerance [rad], speed_tolerance [m/s], yaw_rate_tolerance [rad/s]: the
+        success box. heading_weight [m/rad], velocity_weight [s], yaw_rate_weight [m s/rad]:
+        the weights of the goal distance.
+    """
+
+    goal_x: float
+    goal_y: float
+    goal_phi: float
+    position_tolerance: float
+    heading_tolerance: float
+    speed_tolerance: float
+    yaw_rate_tolerance: float
+    heading_weight: float
+    velocity_weight: float
+    yaw_rate_weight: float
+
+
 class DiffDriveRobotScene(MoreauJeanScene):
     """Batched logic of the diff-drive environments (documented on the env class)."""
 
     MODEL = DiffDriveRobot
     NUM_OBSERVATIONS = 10
+    CONSTANTS = DiffDriveRobotConstants
     OBJECTIVE_OPTIONS = ("time", "effort")
     INFO_KEYS = ("slip_mode", "num_lifted_contacts", "solver_residual", "normal_impulse_left",
                  "normal_impulse_right", "normal_impulse_stick")  # fmt: skip
@@ -65,20 +88,20 @@ class DiffDriveRobotScene(MoreauJeanScene):
         """Rest at the origin heading +x (wheel angles 0)."""
         return np.concatenate([DIFF_DRIVE_MANEUVER.initial_pose, np.zeros(7)])
 
-    def constants(self) -> FloatArray:
-        """(goal x, y, phi, the four tolerances, the three distance weights)."""
-        t = DIFF_DRIVE_MANEUVER
-        return np.array([*t.goal_pose, t.position_tolerance, t.heading_tolerance,
-                         t.speed_tolerance, t.yaw_rate_tolerance, HEADING_WEIGHT,
-                         VELOCITY_WEIGHT, YAW_RATE_WEIGHT])  # fmt: skip
+    def constants(self) -> DiffDriveRobotConstants:
+        """The maneuver's goal pose and four tolerances, the three distance weights."""
+        m = DIFF_DRIVE_MANEUVER
+        return DiffDriveRobotConstants(*m.goal_pose, m.position_tolerance, m.heading_tolerance,
+                                       m.speed_tolerance, m.yaw_rate_tolerance, HEADING_WEIGHT,
+                                       VELOCITY_WEIGHT, YAW_RATE_WEIGHT)  # fmt: skip
 
     @staticmethod
     def observe_one(q: Any, u: Any, brake: Any, time_left: float, c: Any, out: Any) -> None:
         """Goal offset, heading error, body-frame velocity, yaw and wheel rates, time left."""
-        heading_error = q[2] - c[2]
+        heading_error = q[2] - c.goal_phi
         cos_phi, sin_phi = cos_sin(q[2])
-        out[0] = q[0] - c[0]
-        out[1] = q[1] - c[1]
+        out[0] = q[0] - c.goal_x
+        out[1] = q[1] - c.goal_y
         out[2], out[3] = cos_sin(heading_error)
         out[4] = cos_phi * u[0] + sin_phi * u[1]
         out[5] = -sin_phi * u[0] + cos_phi * u[1]
@@ -90,18 +113,22 @@ class DiffDriveRobotScene(MoreauJeanScene):
     @staticmethod
     def distance_one(q: Any, u: Any, c: Any) -> float:
         """sqrt(|dp|^2 + (w_h e_phi)^2 + (w_v |v|)^2 + (w_r phi')^2), e_phi wrapped."""
-        dx, dy = q[0] - c[0], q[1] - c[1]
-        e_phi = wrap_angle(q[2] - c[2])
-        return math.sqrt(dx * dx + dy * dy + (c[7] * e_phi) ** 2
-                         + c[8] * c[8] * (u[0] * u[0] + u[1] * u[1]) + (c[9] * u[2]) ** 2)
+        dx, dy = q[0] - c.goal_x, q[1] - c.goal_y
+        e_phi = wrap_angle(q[2] - c.goal_phi)
+        w_v = c.velocity_weight
+        return math.sqrt(dx * dx + dy * dy + (c.heading_weight * e_phi) ** 2
+                         + w_v * w_v * (u[0] * u[0] + u[1] * u[1])
+                         + (c.yaw_rate_weight * u[2]) ** 2)
 
     @staticmethod
     def success_one(q: Any, u: Any, c: Any) -> bool:
         """Position, heading, speed and yaw rate within the maneuver's tolerances."""
-        dx, dy = q[0] - c[0], q[1] - c[1]
-        e_phi = wrap_angle(q[2] - c[2])
-        return (math.sqrt(dx * dx + dy * dy) <= c[3] and abs(e_phi) <= c[4]
-                and math.sqrt(u[0] * u[0] + u[1] * u[1]) <= c[5] and abs(u[2]) <= c[6])
+        dx, dy = q[0] - c.goal_x, q[1] - c.goal_y
+        e_phi = wrap_angle(q[2] - c.goal_phi)
+        return (math.sqrt(dx * dx + dy * dy) <= c.position_tolerance
+                and abs(e_phi) <= c.heading_tolerance
+                and math.sqrt(u[0] * u[0] + u[1] * u[1]) <= c.speed_tolerance
+                and abs(u[2]) <= c.yaw_rate_tolerance)
 
     @staticmethod
     def info_one(q: Any, u: Any, brake: Any, impulses: Any, physics: Any, c: Any,

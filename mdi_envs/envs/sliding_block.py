@@ -5,7 +5,7 @@ friction must be pushed 0.5 m up the slope and stopped there.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from gymnasium import spaces
@@ -29,11 +29,29 @@ STICK_SPEED = 1e-6  # [m/s] the block counts as sticking below this slip speed, 
 CONTACT_GAP = 1e-6  # [m] the block counts as in contact below this normal distance
 
 
+class SlidingBlockConstants(NamedTuple):
+    """What the compiled scene functions read (``c``).
+
+    Attributes:
+        goal_s [m]; position_tolerance [m], speed_tolerance [m/s]: the success box;
+        velocity_weight [s]: of the speed in the distance; stick_speed [m/s], contact_gap [m]:
+        below these the block counts as sticking, in contact.
+    """
+
+    goal_s: float
+    position_tolerance: float
+    speed_tolerance: float
+    velocity_weight: float
+    stick_speed: float
+    contact_gap: float
+
+
 class SlidingBlockScene(MoreauJeanScene):
     """Batched logic of the sliding-block environments (documented on the env class)."""
 
     MODEL = SlidingBlock
     NUM_OBSERVATIONS = 3
+    CONSTANTS = SlidingBlockConstants
     INFO_KEYS = ("normal_impulse", "friction_impulse", "is_sticking")
 
     def __init__(
@@ -68,28 +86,29 @@ class SlidingBlockScene(MoreauJeanScene):
         """Rest at s = 0 on the slope (n = 0)."""
         return np.zeros(4)
 
-    def constants(self) -> FloatArray:
-        """(goal s, position tol, speed tol, velocity weight, stick speed, contact gap)."""
-        return np.array([GOAL_S, POSITION_TOLERANCE, SPEED_TOLERANCE, VELOCITY_WEIGHT,
-                         STICK_SPEED, CONTACT_GAP])  # fmt: skip
+    def constants(self) -> SlidingBlockConstants:
+        """The goal, the tolerances, the distance weight, the stick and contact thresholds."""
+        return SlidingBlockConstants(GOAL_S, POSITION_TOLERANCE, SPEED_TOLERANCE,
+                                     VELOCITY_WEIGHT, STICK_SPEED, CONTACT_GAP)
 
     @staticmethod
     def observe_one(q: Any, u: Any, brake: Any, time_left: float, c: Any, out: Any) -> None:
         """(s - goal, s', 1 if sticking (in contact, |s'| <= 1e-6 m/s) else 0)."""
-        out[0] = q[0] - c[0]
+        out[0] = q[0] - c.goal_s
         out[1] = u[0]
-        out[2] = 1.0 if (q[1] <= c[5] and abs(u[0]) <= c[4]) else 0.0
+        out[2] = 1.0 if (q[1] <= c.contact_gap and abs(u[0]) <= c.stick_speed) else 0.0
 
     @staticmethod
     def distance_one(q: Any, u: Any, c: Any) -> float:
         """sqrt((s - goal)^2 + (w s')^2), w = 0.3 s."""
-        e = q[0] - c[0]
-        return math.sqrt(e * e + c[3] * c[3] * u[0] * u[0])
+        e = q[0] - c.goal_s
+        w = c.velocity_weight
+        return math.sqrt(e * e + w * w * u[0] * u[0])
 
     @staticmethod
     def success_one(q: Any, u: Any, c: Any) -> bool:
         """|s - goal| <= 0.02 m and |s'| <= 0.02 m/s."""
-        return abs(q[0] - c[0]) <= c[1] and abs(u[0]) <= c[2]
+        return abs(q[0] - c.goal_s) <= c.position_tolerance and abs(u[0]) <= c.speed_tolerance
 
     @staticmethod
     def info_one(q: Any, u: Any, brake: Any, impulses: Any, physics: Any, c: Any,
@@ -97,7 +116,7 @@ class SlidingBlockScene(MoreauJeanScene):
         """P_N, P_T of the last physics step [N s]; sticking (P_N > 0 and |s'| <= 1e-6 m/s)."""
         out[0] = impulses[0]
         out[1] = impulses[1]
-        out[2] = 1.0 if (impulses[0] > 0.0 and abs(u[0]) <= c[4]) else 0.0
+        out[2] = 1.0 if (impulses[0] > 0.0 and abs(u[0]) <= c.stick_speed) else 0.0
 
 
 class SlidingBlockEnv(MoreauJeanEnv):
