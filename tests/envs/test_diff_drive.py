@@ -42,7 +42,7 @@ def test_full_opposite_torques_spin_and_slip() -> None:
     assert 5 in modes
 
 
-def test_effort_task_ends_at_the_fixed_horizon() -> None:
+def test_effort_objective_ends_at_the_fixed_horizon() -> None:
     env = make(objective="effort")
     env.reset(seed=0)
     num_steps = round(DIFF_DRIVE_MANEUVER.effort_final_time / env.unwrapped.dt)

@@ -15,7 +15,10 @@ def as_array(value: object, shape: tuple[int, ...]) -> np.ndarray:
     return np.array(value, dtype=float).reshape(shape)
 
 
-@pytest.mark.parametrize("model", [BouncingBall, SlidingBlock, BlockableManipulator],
+# each model's eight kernels compile in the test (closures: not in the disk cache); the two
+# larger models' compiles take minutes on a loaded machine
+@pytest.mark.parametrize("model", [BouncingBall, pytest.param(SlidingBlock, marks=pytest.mark.slow),
+                                   pytest.param(BlockableManipulator, marks=pytest.mark.slow)],
                          ids=lambda m: m.NAME)  # fmt: skip
 def test_compiled_equals_plain_python(model: type) -> None:
     eq = compile_equations(model)
