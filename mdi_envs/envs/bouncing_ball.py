@@ -33,9 +33,9 @@ class BouncingBallConstants(NamedTuple):
     """What the compiled scene functions read (``c``).
 
     Attributes:
-        goal_x [m], radius [m], gravity [m/s^2]; position_tolerance [m], speed_tolerance
-        [m/s], gap_tolerance [m]: the success box; velocity_weight [s]: of the horizontal speed
-        in the distance.
+        goal_x, radius, gravity: the goal [m], the ball's radius [m], gravity [m/s^2].
+        position_tolerance, speed_tolerance, gap_tolerance: the success box [m], [m/s], [m].
+        velocity_weight: of the horizontal speed in the distance [s].
     """
 
     goal_x: float

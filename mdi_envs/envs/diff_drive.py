@@ -30,10 +30,11 @@ class DiffDriveRobotConstants(NamedTuple):
     """What the compiled scene functions read (``c``).
 
     Attributes:
-        goal_x, goal_y [m], goal_phi [rad]: the goal pose. position_tolerance [m],
-        heading_tolerance [rad], speed_tolerance [m/s], yaw_rate_tolerance [rad/s]: the
-        success box. heading_weight [m/rad], velocity_weight [s], yaw_rate_weight [m s/rad]:
-        the weights of the goal distance.
+        goal_x, goal_y, goal_phi: the goal pose [m], [m], [rad].
+        position_tolerance, heading_tolerance, speed_tolerance, yaw_rate_tolerance: the
+            success box [m], [rad], [m/s], [rad/s].
+        heading_weight, velocity_weight, yaw_rate_weight: the weights of the goal distance
+            [m/rad], [s], [m s/rad].
     """
 
     goal_x: float

@@ -33,9 +33,11 @@ class SlidingBlockConstants(NamedTuple):
     """What the compiled scene functions read (``c``).
 
     Attributes:
-        goal_s [m]; position_tolerance [m], speed_tolerance [m/s]: the success box;
-        velocity_weight [s]: of the speed in the distance; stick_speed [m/s], contact_gap [m]:
-        below these the block counts as sticking, in contact.
+        goal_s: the goal [m].
+        position_tolerance, speed_tolerance: the success box [m], [m/s].
+        velocity_weight: of the speed in the distance [s].
+        stick_speed, contact_gap: below these the block counts as sticking, in contact [m/s],
+            [m].
     """
 
     goal_s: float
