@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import logging
 import re
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 HISTORY = re.compile(
@@ -43,3 +46,31 @@ def test_no_development_history() -> None:
             for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
             if HISTORY.search(line)]
     assert not hits, "development history:\n" + "\n".join(hits)
+
+
+def test_docstrings_parse_as_google() -> None:
+    """Every docstring of the documented packages parses cleanly (what the API pages render)."""
+    griffe = pytest.importorskip("griffe")
+    problems: list[str] = []
+
+    class Collect(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            if record.levelno >= logging.WARNING:
+                problems.append(record.getMessage())
+
+    handler = Collect()
+    logger = logging.getLogger("griffe")
+    logger.addHandler(handler)
+    try:
+        loader = griffe.GriffeLoader(search_paths=[str(ROOT)])
+        stack = [loader.load(name) for name in ("mdi_envs", "optimal", "baselines")]
+        while stack:
+            obj = stack.pop()
+            if obj.docstring is not None:  # the options of mkdocs.yml
+                obj.docstring.parse("google", warn_unknown_params=False,
+                                    warn_missing_types=False)
+            stack += [m for name, m in obj.members.items()
+                      if not m.is_alias and not name.startswith("_")]
+    finally:
+        logger.removeHandler(handler)
+    assert not problems, "\n".join(problems)
