@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -13,18 +15,25 @@ from baselines import heuristics
 from mdi_envs.maneuvers import MANIPULATOR_MANEUVER
 
 
+def _play(env: gym.Env, policy: Callable[[np.ndarray], np.ndarray], seed: int,
+          key: str) -> tuple[bool, dict[str, Any], list[Any]]:
+    """One episode from ``reset(seed)``: (terminated, last info, ``info[key]`` per step)."""
+    obs, _ = env.reset(seed=seed)
+    values, done = [], False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        values.append(info[key])
+        done = terminated or truncated
+    return terminated, info, values
+
+
 def test_rigid_arm_bang_bang_takes_the_double_integrators_time() -> None:
     """Brake engaged throughout; time = the rigid body's bang-bang time into the goal box."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = gym.make("mdi_envs/BlockableManipulator-v1", reset_noise_scale=0.0)
-    policy = heuristics.rigid_arm_bang_bang(env)
-    obs, _ = env.reset(seed=0)
-    engaged, done = [], False
-    while not done:
-        obs, _, terminated, truncated, info = env.step(policy(obs))
-        engaged.append(info["brake_engaged"])
-        done = terminated or truncated
+    terminated, info, engaged = _play(env, heuristics.rigid_arm_bang_bang(env), 0,
+                                      "brake_engaged")
     assert terminated and info["is_success"] and all(engaged)
     p = env.unwrapped.scene.parameters
     inertia = (p.link1_mass * p.link1_length**2 / 3 + p.link2_mass * p.link1_length**2
@@ -63,12 +72,6 @@ def test_rolling_path_follower_reaches_the_goal_without_slipping() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = gym.make("mdi_envs/DiffDriveRobot-v1", reset_noise_scale=0.1)
-    policy = heuristics.rolling_path_follower(env)
-    obs, _ = env.reset(seed=3)
-    modes, done = [], False
-    while not done:
-        obs, _, terminated, truncated, info = env.step(policy(obs))
-        modes.append(info["slip_mode"])
-        done = terminated or truncated
+    terminated, info, modes = _play(env, heuristics.rolling_path_follower(env), 3, "slip_mode")
     assert terminated and info["is_success"]
     assert set(modes) == {2}  # both wheels roll throughout
