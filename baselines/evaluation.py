@@ -124,7 +124,8 @@ ControllerFactory = Callable[[str, str], "Controller | None"]
 """(env id, objective) -> a controller, or None where it does not apply."""
 
 CONTROLLER_FACTORIES: list[str] = ["baselines.evaluation:optimal_controller",
-                                   "baselines.heuristics:heuristic_controller"]
+                                   "baselines.heuristics:heuristic_controller",
+                                   "baselines.model_based:lqr_controller"]
 """The untrained controller rows, as "module:function" of a ``ControllerFactory`` (imported on
 use). ``register_controller`` adds one; every study plays them in this order."""
 

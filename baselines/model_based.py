@@ -1,4 +1,8 @@
-"""Model-based controller rows of the comparison: the shrinking-horizon MPC (``optimal.mpc``).
+"""Model-based controller rows of the comparison: the time-varying LQR, the shrinking-horizon MPC.
+
+``lqr_controller(env_id, objective)`` plays ``optimal.lqr.TimeVaryingLQR`` along the reference of
+(env id, objective), in the same env configuration as the MPC below; it costs microseconds per
+step and is registered in ``baselines.evaluation.CONTROLLER_FACTORIES``, so every study plays it.
 
 ``mpc_controller(env_id, objective)`` plays ``ShrinkingHorizonMPC`` around the reference of (env
 id, objective) in the env configured like the reference's open-loop replay (one env step per
@@ -16,11 +20,40 @@ import importlib.util
 from typing import Any
 
 from baselines.evaluation import REFERENCE_NAMES, Controller
-from optimal.references import load_reference
+from optimal.references import Reference, load_reference
 from optimal.replay import env_options
 
 MPC = "MPC (shrinking horizon)"
 """The label of the MPC rows."""
+
+LQR = "LQR (time-varying)"
+"""The label of the LQR rows."""
+
+
+def _env_options(reference: Reference) -> dict[str, Any]:
+    """The reference's env options; time-optimal objectives get twice its steps."""
+    options = env_options(reference)
+    options.pop("reset_noise_scale")
+    if reference.metadata["cost_kind"] == "time":
+        options["max_episode_steps"] = 2 * len(reference.tau)
+    return options
+
+
+def lqr_controller(env_id: str, objective: str) -> Controller | None:
+    """The LQR along the reference of (env id, objective); None without a reference."""
+    name = REFERENCE_NAMES.get((env_id, objective))
+    if name is None:
+        return None
+    from optimal.lqr import TimeVaryingLQR
+
+    reference = load_reference(name)
+    controller = TimeVaryingLQR(reference)
+
+    def make_policy(_env: Any) -> TimeVaryingLQR:
+        controller.reset()
+        return controller
+
+    return Controller(LQR, make_policy, _env_options(reference))
 
 
 def mpc_controller(env_id: str, objective: str) -> Controller | None:
@@ -31,18 +64,13 @@ def mpc_controller(env_id: str, objective: str) -> Controller | None:
     from optimal.mpc import ShrinkingHorizonMPC
 
     reference = load_reference(name)
-    options = env_options(reference)
-    options.pop("reset_noise_scale")
-    if reference.metadata["cost_kind"] == "time":
-        options["max_episode_steps"] = 2 * len(reference.tau)
-
     controller = ShrinkingHorizonMPC(reference)
 
     def make_policy(_env: Any) -> ShrinkingHorizonMPC:
         controller.reset()  # a new episode: the plan goes, the built NLPs stay
         return controller
 
-    return Controller(MPC, make_policy, options)
+    return Controller(MPC, make_policy, _env_options(reference))
 
 
-__all__ = ["MPC", "mpc_controller"]
+__all__ = ["LQR", "MPC", "lqr_controller", "mpc_controller"]

@@ -30,10 +30,8 @@ plan on one of two grids (``GRIDS``; per reference ``GRID_OF_REFERENCE``):
   ``min_horizon``) intervals beyond that. Each interval of t_f / N is held for h by the env.
 
 ``ShrinkingHorizonMPC(reference)`` is a policy: ``controller(observation) -> action`` in the
-env's default Box action space (the observation is decoded into (q, u): the manipulator's
-angles from their cos/sin, unwrapped against the plan; the robot's pose from its goal offset
-and heading error, the world velocity from the body-frame one; the robot's wheel angles,
-which no dynamics depend on, from the plan), or ``controller.control(q, u)`` on a state.
+env's default Box action space (the observation decoded into (q, u) against the plan by
+``optimal.observations.decode_observation``), or ``controller.control(q, u)`` on a state.
 ``controller.steps`` records the compute per control step. Needs CasADi.
 """
 
@@ -48,11 +46,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from mdi_envs._types import FloatArray
-from mdi_envs.angles import wrap_angle
 from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
 from optimal.continuation import SCHEDULES, Schedule, solve_continuation
 from optimal.mode_search import ModeSolve, solve_with_modes
 from optimal.modes import ModePattern
+from optimal.observations import decode_observation
 from optimal.problems import make_problem
 from optimal.references import Reference
 from optimal.solution import SLIP_TOLERANCE, read_modes, read_solution, values_at
@@ -285,21 +283,8 @@ class ShrinkingHorizonMPC:
 
     def decode(self, observation: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(q, u) from an observation; angles unwrapped against the plan's prediction."""
-        predicted = self._predicted_q()
-        if self.base.model.NUM_BRAKES:  # the manipulator: (cos a, sin a, cos b, sin b, a', b')
-            angles = [math.atan2(observation[2 * i + 1], observation[2 * i]) for i in range(2)]
-            q = np.array([p + wrap_angle(a - p) for a, p in zip(angles, predicted, strict=True)])
-            return q, observation[4:6].copy()
-        goal = DIFF_DRIVE_MANEUVER.goal_pose  # the robot: goal offset, heading error, body velocity
-        heading = goal[2] + math.atan2(observation[3], observation[2])
-        heading = predicted[2] + wrap_angle(heading - predicted[2])
-        cos_phi, sin_phi = math.cos(heading), math.sin(heading)
-        forward, lateral = observation[4], observation[5]
-        q = np.array([observation[0] + goal[0], observation[1] + goal[1], heading,
-                      predicted[3], predicted[4]])
-        u = np.array([cos_phi * forward - sin_phi * lateral,
-                      sin_phi * forward + cos_phi * lateral, *observation[6:9]])
-        return q, u
+        return decode_observation(observation, self._predicted_q(),
+                                  bool(self.base.model.NUM_BRAKES))
 
     def _predicted_q(self) -> FloatArray:
         if self._plan is None:

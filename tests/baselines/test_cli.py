@@ -13,6 +13,7 @@ import pytest
 from baselines.cli import add_compare_parser, add_robustness_parser
 from baselines.evaluation import TRAINED_DIR
 from baselines.heuristics import FOLLOWER
+from baselines.model_based import LQR
 from baselines.records import OPTIMAL, read_study, write_study
 from baselines.tables import comparison_table, interval_text, robustness_table
 
@@ -55,7 +56,7 @@ def test_compare_plays_two_scales_and_merges_a_rerun(tmp_path: Path,
     path = out / "compare_DiffDriveRobot-v0_effort.json"
     study = read_study(path)
     assert [c.scale for c in study.conditions] == [0.01, 0.1]
-    assert [row.label for row in study.rows] == [OPTIMAL, FOLLOWER]  # no trained policies
+    assert [row.label for row in study.rows] == [OPTIMAL, FOLLOWER, LQR]  # no trained policies
     optimal = study.row(OPTIMAL)
     assert [run.condition.scale for run in optimal.runs] == [0.01, 0.1]
     assert all(run.commit and run.nominal.trajectory for run in optimal.runs)
@@ -101,9 +102,10 @@ def test_robustness_writes_json_plot_and_table(tmp_path: Path) -> None:
     assert (out / "robustness_DiffDriveRobot-v0_effort.png").stat().st_size > 0
     rows = [line.split("|")[1].strip() for line in
             (out / "robustness.md").read_text().splitlines() if line.startswith("| ")]
-    assert OPTIMAL in rows and FOLLOWER in rows
-    # one line per episode: the open loop and the floor under 0.01 and the four mismatches
-    assert len((out / "episodes.jsonl").read_text().splitlines()) == 2 * 5
+    assert OPTIMAL in rows and FOLLOWER in rows and LQR in rows
+    # one line per episode: the open loop, the floor and the LQR under 0.01 and the four
+    # mismatches
+    assert len((out / "episodes.jsonl").read_text().splitlines()) == 3 * 5
     # a run of another objective keeps this one's rows in robustness.md
     assert run("robustness", ROBOT, "--objective", "time", "--seeds", "1", "--scales", "0.01",
                "--no-mismatch", "--trained", str(tmp_path), "--output", str(out)) == 0

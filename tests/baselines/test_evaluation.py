@@ -27,6 +27,7 @@ from baselines.evaluation import (
     shipped_policies,
 )
 from baselines.heuristics import BANG_BANG, FOLLOWER
+from baselines.model_based import LQR
 from baselines.records import OPTIMAL, Condition, Episode, Scores, Study, read_study, write_study
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
 from optimal.references import load_reference
@@ -96,7 +97,7 @@ def test_the_perturbation_scale_is_a_parameter(tmp_path: Path) -> None:
     study = evaluate(ROBOT, "time", [Condition(0.0), Condition(0.3)], num_starts=1,
                      trained_dir=tmp_path)  # fmt: skip
     assert [c.label for c in study.conditions] == ["perturbation 0", "perturbation 0.3"]
-    assert [row.label for row in study.rows] == [OPTIMAL, FOLLOWER]  # no trained policies
+    assert [row.label for row in study.rows] == [OPTIMAL, FOLLOWER, LQR]  # no trained policies
     exact, far = (run.scores for run in study.row(OPTIMAL).runs)
     # from the unperturbed start the open-loop optimum reaches the goal at its own t_f
     assert exact.success_rate == 1.0 and exact.time_ratio == pytest.approx(1.0, abs=1e-6)
@@ -127,13 +128,14 @@ def test_scores_count_only_successes() -> None:
 
 def test_the_controller_registry(monkeypatch: pytest.MonkeyPatch) -> None:
     assert CONTROLLER_FACTORIES[0] == "baselines.evaluation:optimal_controller"
-    assert [c.label for c in registered_controllers(ROBOT, "effort")] == [OPTIMAL, FOLLOWER]
-    assert [c.label for c in registered_controllers(MANIPULATOR, "time")] == [OPTIMAL, BANG_BANG]
+    assert [c.label for c in registered_controllers(ROBOT, "effort")] == [OPTIMAL, FOLLOWER, LQR]
+    assert [c.label for c in registered_controllers(MANIPULATOR, "time")] == [OPTIMAL, BANG_BANG,
+                                                                             LQR]
     assert registered_controllers(MANIPULATOR, "effort") == []  # no reference: no row
     monkeypatch.setattr(evaluation_module, "CONTROLLER_FACTORIES", list(CONTROLLER_FACTORIES))
     register_controller(f"{__name__}:random_factory")
     register_controller(f"{__name__}:random_factory")  # idempotent
-    assert [c.label for c in registered_controllers(ROBOT, "time")] == [OPTIMAL, FOLLOWER,
+    assert [c.label for c in registered_controllers(ROBOT, "time")] == [OPTIMAL, FOLLOWER, LQR,
                                                                        "random"]  # fmt: skip
     with pytest.raises(ValueError, match="module:function"):
         register_controller("random_factory")
@@ -203,11 +205,11 @@ def test_merge_orders_conditions_and_drops_withdrawn_rows(manipulator_study: Stu
     merged = merge(old, new, shipped=set())
     assert [c.label for c in merged.conditions] == ["perturbation 0.01", "perturbation 0.1",
                                                     "link masses -10 %"]  # fmt: skip
-    assert [row.label for row in merged.rows] == [OPTIMAL, BANG_BANG, "reference controls",
+    assert [row.label for row in merged.rows] == [OPTIMAL, BANG_BANG, LQR, "reference controls",
                                                   "random"]  # fmt: skip
     assert [run.condition for run in merged.rows[0].runs] == [Condition(), mismatch]
     assert merged.rows[1] == old.rows[1]  # a row not played again is kept as it was
-    assert len(merge(old, new).rows) == 5  # no list of shipped algorithms: PPO kept
+    assert len(merge(old, new).rows) == 6  # no list of shipped algorithms: PPO kept
     with pytest.raises(ValueError, match="num_starts"):
         merge(old, dataclasses.replace(old, num_starts=3))
 

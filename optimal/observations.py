@@ -1,0 +1,50 @@
+"""The state (q, u) of a mission env's observation, for the model-based controllers.
+
+The manipulator's observation carries its angles as (cos, sin) pairs, the robot's its pose as
+the goal offset and heading error and its velocity in the body frame; neither carries the
+robot's wheel angles, on which no dynamics depend. ``decode_observation`` inverts that against
+a predicted q (the controller's plan or reference): angles are unwrapped to the branch nearest
+the prediction and the wheel angles are taken from it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mdi_envs._types import FloatArray
+from mdi_envs.angles import wrap_angle
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
+
+
+def decode_observation(observation: FloatArray, predicted_q: FloatArray,
+                       has_brake: bool) -> tuple[FloatArray, FloatArray]:
+    """(q (n,), u (n,)) from an observation of the manipulator (``has_brake``) or the robot.
+
+    Args:
+        observation: the env's observation, (6,) for the manipulator, (9,) for the robot.
+        predicted_q: (n,) the q the controller expects [rad, m]: the angles are unwrapped
+            against it, the robot's wheel angles copied from it.
+        has_brake: True for the manipulator (cos a, sin a, cos b, sin b, a', b'), False for
+            the robot (goal offset x, y, cos and sin of the heading error, forward and lateral
+            speed, yaw rate, wheel speeds).
+    """
+    observation = np.asarray(observation, dtype=float)
+    if has_brake:
+        angles = [math.atan2(observation[2 * i + 1], observation[2 * i]) for i in range(2)]
+        q = np.array([p + wrap_angle(a - p) for a, p in zip(angles, predicted_q, strict=True)])
+        return q, observation[4:6].copy()
+    goal = DIFF_DRIVE_MANEUVER.goal_pose
+    heading = goal[2] + math.atan2(observation[3], observation[2])
+    heading = predicted_q[2] + wrap_angle(heading - predicted_q[2])
+    cos_phi, sin_phi = math.cos(heading), math.sin(heading)
+    forward, lateral = observation[4], observation[5]
+    q = np.array([observation[0] + goal[0], observation[1] + goal[1], heading,
+                  predicted_q[3], predicted_q[4]])
+    u = np.array([cos_phi * forward - sin_phi * lateral,
+                  sin_phi * forward + cos_phi * lateral, *observation[6:9]])
+    return q, u
+
+
+__all__ = ["decode_observation"]
