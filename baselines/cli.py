@@ -128,8 +128,9 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
         "(rliable) of the success rate and of the time/effort ratios to the optimum as a "
         "Markdown table; write compare_ENV_OBJECTIVE.json, .md and .png (trajectories, brake "
         "schedules / slip modes, scores), seeds_ENV_OBJECTIVE.png (performance profiles, training "
-        "curves) and compare.md into --output (figures of a scale other than 0.01 end in "
-        "_scaleS). ENV_ID 'all' runs both mission envs, every objective.",
+        "curves), brake_ENV_OBJECTIVE.png (brake use per run, manipulator) and compare.md into "
+        "--output (figures of a scale other than 0.01 end in _scaleS). ENV_ID 'all' runs both "
+        "mission envs, every objective.",
     )
     _study_arguments(parser, [DEFAULT_SCALE], "results/compare")
     parser.add_argument("--bootstrap-reps", type=int, default=None,
@@ -229,9 +230,13 @@ def _studies(args: argparse.Namespace, prefix: str, nominal: bool,
 def run_compare(args: argparse.Namespace) -> int:
     """Handler of ``compare``: plays each env x objective, writes the study, figures and tables."""
     from baselines.evaluation import TRAINED_DIR
-    from baselines.plots import plot_comparison, plot_seeds
+    from baselines.plots import plot_brake_use, plot_comparison, plot_seeds
     from baselines.records import Condition, read_study
-    from baselines.tables import comparison_table
+    from baselines.tables import brake_use_table, comparison_table
+
+    def tables(studies: list[Study]) -> str:
+        brake = brake_use_table(studies)
+        return comparison_table(studies) + (f"\n\nBrake use\n\n{brake}" if brake else "") + "\n"
 
     studies = _studies(args, "compare", True, lambda _: [Condition(s) for s in args.scales])
     trained_dir = args.trained or TRAINED_DIR
@@ -242,11 +247,13 @@ def run_compare(args: argparse.Namespace) -> int:
                             condition.label)  # fmt: skip
             plot_seeds(study, args.output / f"seeds_{study.name}{tail}.png", trained_dir,
                        condition.label, args.bootstrap_reps)  # fmt: skip
-        (args.output / f"compare_{study.name}.md").write_text(comparison_table([study]) + "\n")
+            if brake_use_table([study]):
+                plot_brake_use(study, args.output / f"brake_{study.name}{tail}.png",
+                               condition.label)  # fmt: skip
+        (args.output / f"compare_{study.name}.md").write_text(tables([study]))
     everything = [read_study(path) for path in sorted(args.output.glob("compare_*.json"))]
-    table = comparison_table(everything)
-    (args.output / "compare.md").write_text(table + "\n")
-    print(table)
+    (args.output / "compare.md").write_text(tables(everything))
+    print(tables(everything))
     return 0
 
 

@@ -33,6 +33,7 @@ from tqdm import tqdm
 from baselines.records import (
     OPTIMAL,
     Aggregate,
+    BrakeUse,
     Condition,
     Episode,
     Row,
@@ -54,18 +55,27 @@ TRAINED_DIR = Path(__file__).parent / "trained"
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
+MANIPULATOR_V1 = "mdi_envs/BlockableManipulator-v1"
+DIFF_DRIVE_V1 = "mdi_envs/DiffDriveRobot-v1"
+DIFF_DRIVE_EFFORT_V1 = "mdi_envs/DiffDriveRobotEffort-v1"
 
 REFERENCE_NAMES = {
     (MANIPULATOR, "time"): "manipulator_time",
     (DIFF_DRIVE, "time"): "diff_drive_time",
     (DIFF_DRIVE, "effort"): "diff_drive_effort",
+    (MANIPULATOR_V1, "time"): "manipulator_time",
+    (DIFF_DRIVE_V1, "time"): "diff_drive_time",
+    (DIFF_DRIVE_EFFORT_V1, "effort"): "diff_drive_effort",
 }
-"""(env id, objective) -> the optimal reference it is measured against."""
+"""(env id, objective) -> the optimal reference it is measured against (v0 ids take the
+objective as a kwarg, v1 ids have one objective each)."""
 
-OBJECTIVES = {MANIPULATOR: ("time",), DIFF_DRIVE: ("time", "effort")}
+OBJECTIVES = {env_id: tuple(o for e, o in REFERENCE_NAMES if e == env_id)
+              for env_id, _ in REFERENCE_NAMES}
 """The objectives of each mission environment."""
 
-SCHEDULE_KEYS = {MANIPULATOR: "brake_engaged", DIFF_DRIVE: "slip_mode"}
+SCHEDULE_KEYS = {env_id: "brake_engaged" if "Manipulator" in env_id else "slip_mode"
+                 for env_id in OBJECTIVES}
 """The per-step ``info`` entry kept as a schedule: brake engaged (0/1) or slip mode (2/3/5)."""
 
 SCALES = (0.01, 0.03, 0.1, 0.3)
@@ -88,14 +98,17 @@ def _robot(mass: float = 1.0, friction: float = 1.0) -> DiffDriveParameters:
                                stick_friction=friction * nominal.stick_friction)
 
 
+_MANIPULATOR_MISMATCHES: dict[str, Callable[[], Any]] = {
+    "link masses +10 %": lambda: _manipulator(1.1),
+    "link masses -10 %": lambda: _manipulator(0.9)}
+_ROBOT_MISMATCHES: dict[str, Callable[[], Any]] = {
+    "mass +10 %": lambda: _robot(mass=1.1),
+    "mass -10 %": lambda: _robot(mass=0.9),
+    "friction +20 %": lambda: _robot(friction=1.2),
+    "friction -20 %": lambda: _robot(friction=0.8)}
 MISMATCHES: dict[str, dict[str, Callable[[], Any]]] = {
-    MANIPULATOR: {"link masses +10 %": lambda: _manipulator(1.1),
-                  "link masses -10 %": lambda: _manipulator(0.9)},
-    DIFF_DRIVE: {"mass +10 %": lambda: _robot(mass=1.1),
-                 "mass -10 %": lambda: _robot(mass=0.9),
-                 "friction +20 %": lambda: _robot(friction=1.2),
-                 "friction -20 %": lambda: _robot(friction=0.8)},
-}
+    env_id: _MANIPULATOR_MISMATCHES if "Manipulator" in env_id else _ROBOT_MISMATCHES
+    for env_id in OBJECTIVES}
 """Env id -> {label: parameters factory} of its model mismatches (the env's model only). Neither
 mission env has a restitution coefficient (the brake and the wheels have no impacts)."""
 
@@ -231,9 +244,13 @@ def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: 
 
     result = rollout(env_id, timed, seed=seed, **env_kwargs)
     info = result.last_info
+    dt = float(info["elapsed_time"]) / max(result.num_steps, 1)
+    brake_use = None
+    if result.infos and "brake_engaged" in result.infos[0]:
+        brake_use = BrakeUse.of([step["brake_engaged"] for step in result.infos],
+                                [step["brake_impulse"] for step in result.infos], dt)
     trajectory = None
     if keep_trajectory:
-        dt = float(info["elapsed_time"]) / max(result.num_steps, 1)
         key = SCHEDULE_KEYS.get(env_id)
         trajectory = TrajectoryRecord(
             (dt * np.arange(result.num_steps + 1)).tolist(), np.asarray(result.q).tolist(),
@@ -243,7 +260,8 @@ def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: 
         effort=float(info["effort"]),
         solver_failures=sum(int(step["solver_status"] != 0) for step in result.infos),
         compute_per_step=float(np.mean(compute)) if compute else 0.0,
-        episode_return=result.total_reward, num_steps=result.num_steps, trajectory=trajectory)
+        episode_return=result.total_reward, num_steps=result.num_steps, trajectory=trajectory,
+        brake_use=brake_use)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -463,7 +481,8 @@ def merge(old: Study, new: Study, shipped: Collection[str] | None = None) -> Stu
 
 
 __all__ = [
-    "CONTROLLER_FACTORIES", "DIFF_DRIVE", "MANIPULATOR", "MISMATCHES", "OBJECTIVES",
+    "CONTROLLER_FACTORIES", "DIFF_DRIVE", "DIFF_DRIVE_EFFORT_V1", "DIFF_DRIVE_V1", "MANIPULATOR",
+    "MANIPULATOR_V1", "MISMATCHES", "OBJECTIVES",
     "REFERENCE_NAMES", "SCALES", "SCHEDULE_KEYS", "SCORES", "TRAINED_DIR", "Controller",
     "ControllerFactory", "LoggedEpisode", "aggregate", "append_log", "controller_rows",
     "evaluate", "group_by_algorithm", "load_policy", "merge", "optimal_controller",

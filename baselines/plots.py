@@ -7,6 +7,8 @@
 - ``plot_seeds``: rliable performance profiles of the success rate and of the optimality score
   (optimum / the run's mean time or effort over its successes; 0 without success), and the
   training curves (IQM over seeds of the training success rate, log step axis, 95 % band).
+- ``plot_brake_use``: the brake's engaged intervals from the nominal start for every run (each
+  training seed its own line) against the optimum's, and the engagements per perturbed episode.
 - ``plot_robustness``: success against the start perturbation scale, and under each mismatch.
 - ``plot_training``: one run's episode return and success rate against environment steps.
 """
@@ -150,6 +152,49 @@ def plot_comparison(study: Study, path: Path, condition: str | None = None) -> P
     _score_panel(axes[1, 1], study, condition)
     fig.suptitle(f"{study.env_id.split('/')[-1]}, {study.objective}, {condition}: RL vs "
                  f"optimal reference ({study.reference}, {study.optimal_time:.3f} s)")
+    return _save(fig, path)
+
+
+def plot_brake_use(study: Study, path: Path, condition: str | None = None) -> Path:
+    """Write the brake-use figure of ``condition`` (default the first) to ``path``.
+
+    Left: per run (seed), the intervals with the brake engaged from the nominal start
+    (``baselines.tables.engaged_intervals``), rows grouped by controller, the optimum on top.
+    Right: engagements per perturbed episode per controller (points jittered), the optimum's
+    as a dotted line.
+    """
+    from baselines.tables import engaged_intervals
+
+    condition = condition or study.conditions[0].label
+    rows = [row for row in study.rows if row.at(condition)]
+    num_runs = sum(len(row.at(condition)) for row in rows)
+    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 2.0 + 0.3 * num_runs),
+                                      width_ratios=(2, 1))  # fmt: skip
+    labels, level = [], 0
+    rng = np.random.default_rng(0)
+    for index, row in enumerate(rows):
+        colour = _colour(index, row.label)
+        for run in row.at(condition):
+            for start, end in engaged_intervals(run.nominal):
+                left.broken_barh([(start, max(end - start, 1e-3))], (-level - 0.4, 0.8),
+                                 color=colour)  # fmt: skip
+            labels.append(row.label + (f" seed {run.seed}" if row.trained else ""))
+            level += 1
+        counts = [e.brake_use.engagements for run in row.at(condition) for e in run.episodes
+                  if e.brake_use is not None]  # fmt: skip
+        right.scatter(counts, index + rng.uniform(-0.25, 0.25, len(counts)), s=8,
+                      color=colour, alpha=0.6)  # fmt: skip
+        if row.label == OPTIMAL and counts:
+            right.axvline(counts[0], color="black", ls=":", lw=0.8)
+    left.set_yticks(-np.arange(level), labels, fontsize=7)
+    left.set_ylim(-level + 0.5, 0.5)
+    left.set(xlabel="t [s]", title="brake engaged, nominal start (each run)")
+    left.grid(alpha=0.3, axis="x")
+    right.set_yticks(np.arange(len(rows)), [row.label for row in rows], fontsize=7)
+    right.set_ylim(len(rows) - 0.5, -0.5)
+    right.set(xlabel="engagements per episode", title=f"{condition}, perturbed starts")
+    right.grid(alpha=0.3, axis="x")
+    fig.suptitle(f"{study.env_id.split('/')[-1]}: brake use against the optimal reference")
     return _save(fig, path)
 
 

@@ -56,6 +56,35 @@ class Trajectory:
 
 
 @dataclass(frozen=True)
+class BrakeUse:
+    """How one episode used the manipulator's brake.
+
+    Attributes:
+        engagements: env steps with the brake engaged after a step with it released (the first
+            step counts when it starts engaged). engaged_time: time engaged [s].
+        first_engagement: start of the first engaged step [s] (None: never engaged).
+        impulse: sum of the brake impulse magnitudes |P_B| over the episode [N m s].
+    """
+
+    engagements: int
+    engaged_time: float
+    first_engagement: float | None
+    impulse: float
+
+    @classmethod
+    def of(cls, engaged: Sequence[float], impulses: Sequence[float], dt: float) -> BrakeUse:
+        """From an episode's per-step ``info["brake_engaged"]`` (0/1), ``info["brake_impulse"]``.
+
+        ``impulses`` in [N m s]; ``dt`` is the env step [s].
+        """
+        on = np.asarray(engaged, dtype=float) > 0.5
+        starts = np.flatnonzero(on & ~np.concatenate(([False], on[:-1])))
+        return cls(engagements=len(starts), engaged_time=float(on.sum() * dt),
+                   first_engagement=float(starts[0] * dt) if len(starts) else None,
+                   impulse=float(np.abs(np.asarray(impulses, dtype=float)).sum()))  # fmt: skip
+
+
+@dataclass(frozen=True)
 class Episode:
     """One episode from ``reset(seed=seed)``.
 
@@ -65,6 +94,7 @@ class Episode:
         contact solve did not converge. compute_per_step: mean wall time of one policy call
         [s] (an MPC's re-solve, a network's forward pass). episode_return: sum of rewards.
         num_steps: env steps. trajectory: kept for nominal episodes and plotted ones.
+        brake_use: how it used the brake (None: an env without one).
     """
 
     seed: int
@@ -76,6 +106,7 @@ class Episode:
     episode_return: float | None = None
     num_steps: int | None = None
     trajectory: Trajectory | None = None
+    brake_use: BrakeUse | None = None
 
 
 @dataclass(frozen=True)
@@ -283,7 +314,7 @@ def write_study(study: Study, path: Path) -> Path:
 
 
 __all__ = [
-    "DEFAULT_SCALE", "OPTIMAL", "Aggregate", "Condition", "Episode", "Estimate", "Row", "Run",
-    "Scores", "Study", "Training", "Trajectory", "from_json", "read_study", "to_json",
+    "DEFAULT_SCALE", "OPTIMAL", "Aggregate", "BrakeUse", "Condition", "Episode", "Estimate", "Row",
+    "Run", "Scores", "Study", "Training", "Trajectory", "from_json", "read_study", "to_json",
     "write_study",
 ]

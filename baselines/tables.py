@@ -2,6 +2,8 @@
 
 ``comparison_table``: one row per env x objective x condition x controller with the IQM [95 % CI]
 over runs (n) of each score, the nominal start, the compute per step and the training budget.
+``brake_use_table``: per study with a brake, how each controller uses it (engagements per episode,
+time engaged, first engagement, impulse) and the nominal episode's engaged intervals.
 ``robustness_table``: per study, one row per controller and one column per condition with the
 success rate (mean over runs) and, over the successes, the time or effort ratio (mean over the
 runs with successes). Both read the rows' aggregates (``baselines.evaluation.aggregate``).
@@ -14,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from baselines.records import Estimate, Row, Study
+from baselines.records import Episode, Estimate, Row, Study
 
 
 def interval_text(estimate: Estimate, percent: bool = False) -> str:
@@ -99,6 +101,55 @@ def comparison_table(studies: Sequence[Study]) -> str:
     return pd.DataFrame(records, columns=columns).to_markdown(index=False)
 
 
+def engaged_intervals(episode: Episode | None) -> list[tuple[float, float]]:
+    """The (start, end) times [s] of the brake's engaged intervals in a kept trajectory."""
+    if episode is None or episode.trajectory is None or not episode.trajectory.schedule:
+        return []
+    time = np.asarray(episode.trajectory.time)
+    on = np.concatenate(([False], np.asarray(episode.trajectory.schedule) > 0.5, [False]))
+    edges = np.flatnonzero(np.diff(on.astype(int)))
+    return [(float(time[a]), float(time[b])) for a, b in edges.reshape(-1, 2)]
+
+
+def _intervals_text(intervals: list[tuple[float, float]], shown: int = 4) -> str:
+    """"2.02-2.55, 4.15-4.19", the first ``shown`` intervals and "+k more" ("-": none)."""
+    text = ", ".join(f"{a:.2f}-{b:.2f}" for a, b in intervals[:shown])
+    more = len(intervals) - shown
+    return (text + (f", +{more} more" if more > 0 else "")) or "-"
+
+
+def brake_use_table(studies: Sequence[Study]) -> str:
+    """One row per study x condition x controller: how the brake is used (``BrakeUse``).
+
+    Over the row's perturbed episodes (all runs): engagements per episode (mean, range), time
+    engaged [s], the median first engagement [s] and the impulse [N m s] (means); the engaged
+    intervals of the first run's nominal episode. Studies without brake records are left out.
+    """
+    records = []
+    for study in studies:
+        for condition in study.conditions:
+            for row in study.rows:
+                runs = row.at(condition.label)
+                uses = [e.brake_use for run in runs for e in run.episodes
+                        if e.brake_use is not None]  # fmt: skip
+                if not uses:
+                    continue
+                counts = [use.engagements for use in uses]
+                firsts = [use.first_engagement for use in uses if use.first_engagement is not None]
+                nominal = engaged_intervals(runs[0].nominal) if runs else []
+                records.append([
+                    study.env_id.split("/")[-1], f"{condition.scale:g}", row.label, len(runs),
+                    f"{np.mean(counts):.1f} ({min(counts)}-{max(counts)})",
+                    f"{np.mean([use.engaged_time for use in uses]):.2f}",
+                    f"{np.median(firsts):.2f}" if firsts else "never",
+                    f"{np.mean([use.impulse for use in uses]):.3g}",
+                    _intervals_text(nominal)])  # fmt: skip
+    columns = ["env", "start scale", "controller", "runs", "engagements / episode (range)",
+               "engaged [s]", "first engagement [s], median", "impulse [N m s]",
+               "engaged (nominal start, first run) [s]"]
+    return pd.DataFrame(records, columns=columns).to_markdown(index=False) if records else ""
+
+
 def robustness_table(studies: Sequence[Study]) -> str:
     """Per study a title line and a table: success (ratio over the successes) per condition.
 
@@ -129,4 +180,5 @@ def robustness_table(studies: Sequence[Study]) -> str:
     return "\n\n".join(parts)
 
 
-__all__ = ["budget_text", "comparison_table", "interval_text", "robustness_table"]
+__all__ = ["brake_use_table", "budget_text", "comparison_table", "engaged_intervals",
+           "interval_text", "robustness_table"]

@@ -27,7 +27,7 @@ import pandas as pd
 
 import mdi_envs  # noqa: F401  (registers the ids)
 from baselines.records import read_study
-from baselines.tables import comparison_table, robustness_table
+from baselines.tables import brake_use_table, comparison_table, robustness_table
 from optimal import available_references, load_reference
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -275,6 +275,12 @@ def comparison_page() -> None:
              "In full (`baselines.tables.comparison_table`): the nominal start, the compute per "
              "policy call and the training budget of each row.", "",
              comparison_table(studies), ""]
+    brake = brake_use_table(studies)
+    if brake:
+        lines += ["## Brake use", "",
+                  "How each controller uses the manipulator's brake over its perturbed episodes "
+                  "(`baselines.tables.brake_use_table`), and when it is engaged from the "
+                  "nominal start; the figures `brake_*.png` show every run.", "", brake, ""]
     for png in sorted(folder.glob("*.png")):
         lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
     floors = ROOT / "baselines" / "heuristics.json"

@@ -14,6 +14,7 @@ import pytest
 import baselines.evaluation as evaluation_module
 from baselines.evaluation import (
     CONTROLLER_FACTORIES,
+    DIFF_DRIVE_EFFORT_V1,
     MISMATCHES,
     Controller,
     evaluate,
@@ -28,7 +29,17 @@ from baselines.evaluation import (
 )
 from baselines.heuristics import BANG_BANG, FOLLOWER
 from baselines.model_based import LQR
-from baselines.records import OPTIMAL, Condition, Episode, Scores, Study, read_study, write_study
+from baselines.records import (
+    OPTIMAL,
+    BrakeUse,
+    Condition,
+    Episode,
+    Scores,
+    Study,
+    read_study,
+    write_study,
+)
+from baselines.tables import brake_use_table, engaged_intervals
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
 from optimal.references import load_reference
 
@@ -77,6 +88,40 @@ def test_optimal_controls_score_the_optimum(manipulator_study: Study) -> None:
         assert run.training is None and run.seed is None and run.commit
 
 
+def test_brake_use_of_the_optimum_is_its_schedule(manipulator_study: Study) -> None:
+    """The env's brake record of the replayed optimum against the NLP's brake and impulses."""
+    reference = load_reference("manipulator_time")
+    nominal = manipulator_study.row(OPTIMAL).runs[0].nominal
+    steps, h = nominal.num_steps, reference.time_step
+    engaged = reference.brake_bound[:steps, 0] > 0.0
+    starts = np.flatnonzero(engaged & ~np.concatenate(([False], engaged[:-1])))
+    use = nominal.brake_use
+    assert use is not None and use.engagements == len(starts) >= 2
+    assert use.first_engagement == pytest.approx(starts[0] * h, rel=1e-9)
+    assert use.engaged_time == pytest.approx(engaged.sum() * h, rel=1e-9)
+    impulses = reference.arrays["brake_impulse"][:steps]
+    assert use.impulse == pytest.approx(np.abs(impulses).sum(), rel=1e-4)
+    intervals = engaged_intervals(nominal)
+    assert [a for a, _ in intervals] == pytest.approx(list(starts * h), rel=1e-9)
+    assert sum(b - a for a, b in intervals) == pytest.approx(use.engaged_time, rel=1e-9)
+
+
+def test_brake_use_counts_engagements() -> None:
+    use = BrakeUse.of([1, 1, 0, 0, 1, 0, 1], [0.5, 0.0, 0.0, 0.0, -0.25, 0.0, 0.125], 0.1)
+    assert use == BrakeUse(engagements=3, engaged_time=pytest.approx(0.4), first_engagement=0.0,
+                           impulse=0.875)  # fmt: skip
+    never = BrakeUse.of([0, 0], [0.0, 0.0], 0.1)
+    assert never.engagements == 0 and never.first_engagement is None and never.impulse == 0.0
+
+
+def test_brake_use_table_lists_the_brake_rows(manipulator_study: Study, tmp_path: Path) -> None:
+    table = brake_use_table([manipulator_study])
+    assert all(label in table for label in (OPTIMAL, "reference controls", "random"))
+    robot = evaluate(ROBOT, "time", num_starts=1, trained_dir=tmp_path)
+    assert robot.row(OPTIMAL).runs[0].episodes[0].brake_use is None
+    assert brake_use_table([robot]) == ""
+
+
 def test_random_policy_is_reported_as_failure(manipulator_study: Study) -> None:
     (run,) = manipulator_study.row("random").runs
     assert run.scores.success_rate == 0.0
@@ -104,10 +149,11 @@ def test_the_perturbation_scale_is_a_parameter(tmp_path: Path) -> None:
     assert far.success_rate == 0.0  # 0.3 m / rad of start error: open loop cannot absorb it
 
 
-def test_effort_task_reference_ratio_one(tmp_path: Path) -> None:
+@pytest.mark.parametrize("env_id", [ROBOT, DIFF_DRIVE_EFFORT_V1])
+def test_effort_task_reference_ratio_one(tmp_path: Path, env_id: str) -> None:
     reference = load_reference("diff_drive_effort")
     assert reference_effort(reference) == pytest.approx(reference.cost, rel=1e-12)
-    study = evaluate(ROBOT, "effort", num_starts=1, nominal=True, trained_dir=tmp_path)
+    study = evaluate(env_id, "effort", num_starts=1, nominal=True, trained_dir=tmp_path)
     nominal = study.row(OPTIMAL).runs[0].nominal
     assert nominal is not None and nominal.is_success
     assert nominal.effort / study.optimal_effort == pytest.approx(1.0, rel=1e-6)
