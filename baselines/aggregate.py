@@ -8,7 +8,10 @@ effort ratio to the optimum) is one sample; the interquartile mean (IQM,
 bootstrap (``rliable.library.get_interval_estimates``, percentile method, over runs) its
 confidence interval. One run gives no interval (``ci`` None: "n=1, no CI"). Performance
 profiles (``rliable.library.create_performance_profile``): the fraction of runs whose score
-exceeds each threshold tau, with bootstrap bands. Training curves: each run's success rate
+exceeds each threshold tau, with bootstrap bands. Probability of improvement
+(``rliable.metrics.probability_of_improvement``): P(X > Y) of a run of X against a run of Y
+(the Mann-Whitney U statistic over n x m pairs, ties counted half), with an independent
+stratified-bootstrap CI. Training curves: each run's success rate
 (moving mean over its last 100 training episodes) on a common grid of environment steps,
 IQM and CI per grid point.
 
@@ -119,6 +122,32 @@ def performance_profiles(scores: Mapping[str, Sequence[float]], taus: np.ndarray
     return {label: {**profiles, **singles}[label] for label in matrices}, dict(intervals)
 
 
+def optimality_score(ratio: float | None) -> float:
+    """Optimum / the run's mean time or effort over its successes (``ratio``); 0 if none."""
+    return 0.0 if ratio is None else 1.0 / ratio
+
+
+def improvement_probability(x: Sequence[float], y: Sequence[float], reps: int = BOOTSTRAP_REPS,
+                            seed: int = 0) -> tuple[float, tuple[float, float] | None]:
+    """P(X > Y) over runs (one score per run of X and of Y) and its 95 % CI.
+
+    The CI (independent stratified bootstrap of both samples) is None when neither has two
+    runs or ``reps`` is 0.
+    """
+    from rliable import library, metrics
+
+    scores = (np.asarray(x, dtype=float)[:, None], np.asarray(y, dtype=float)[:, None])
+    point = float(metrics.probability_of_improvement(*scores))
+    if max(len(x), len(y)) < 2 or reps <= 0:
+        return point, None
+    with _seeded(seed):
+        _, intervals = library.get_interval_estimates(
+            {"pair": scores}, metrics.probability_of_improvement, reps=reps,
+            confidence_interval_size=CONFIDENCE)  # fmt: skip
+    low, high = np.ravel(intervals["pair"])
+    return point, (float(low), float(high))
+
+
 CURVE_POINTS = 200
 """Points of a run's compact training curve (``sampled_curve``, ``STEM_curve.csv``)."""
 
@@ -214,6 +243,7 @@ def training_curves(runs: Mapping[str, Sequence[tuple[np.ndarray, np.ndarray]]],
 
 
 __all__ = [
-    "BOOTSTRAP_REPS", "CONFIDENCE", "CURVE_POINTS", "Curve", "iqm_interval", "performance_profiles",
-    "sampled_curve", "success_curve", "training_curves",
+    "BOOTSTRAP_REPS", "CONFIDENCE", "CURVE_POINTS", "Curve", "improvement_probability",
+    "iqm_interval", "optimality_score", "performance_profiles", "sampled_curve", "success_curve",
+    "training_curves",
 ]

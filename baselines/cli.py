@@ -232,11 +232,14 @@ def run_compare(args: argparse.Namespace) -> int:
     from baselines.evaluation import TRAINED_DIR
     from baselines.plots import plot_brake_use, plot_comparison, plot_seeds
     from baselines.records import Condition, read_study
-    from baselines.tables import brake_use_table, comparison_table
+    from baselines.tables import brake_use_table, comparison_table, improvement_table
 
     def tables(studies: list[Study]) -> str:
-        brake = brake_use_table(studies)
-        return comparison_table(studies) + (f"\n\nBrake use\n\n{brake}" if brake else "") + "\n"
+        sections = [comparison_table(studies)]
+        for title, text in (("Probability of improvement", improvement_table(
+                studies, args.bootstrap_reps)), ("Brake use", brake_use_table(studies))):
+            sections += [title, text] if text else []
+        return "\n\n".join(sections) + "\n"
 
     studies = _studies(args, "compare", True, lambda _: [Condition(s) for s in args.scales])
     trained_dir = args.trained or TRAINED_DIR

@@ -218,11 +218,6 @@ def read_curve(training: Training, trained_dir: Path) -> tuple[np.ndarray, np.nd
     return sampled_curve(frame["timesteps"].to_numpy(float), frame["is_success"].to_numpy(float))
 
 
-def optimality_score(ratio: float | None) -> float:
-    """Optimum / the run's mean time or effort over its successes (``ratio``); 0 if none."""
-    return 0.0 if ratio is None else 1.0 / ratio
-
-
 def _profile_panel(ax: Any, scores: dict[str, list[float]], colours: dict[str, str],
                    xlabel: str, title: str, reps: int) -> None:  # fmt: skip
     from rliable import plot_utils
@@ -275,7 +270,7 @@ def plot_seeds(study: Study, path: Path, trained_dir: Path, condition: str | Non
 
     ``reps``: bootstrap replications of the bands (default ``aggregate.BOOTSTRAP_REPS``).
     """
-    from baselines.aggregate import BOOTSTRAP_REPS
+    from baselines.aggregate import BOOTSTRAP_REPS, optimality_score
 
     reps = BOOTSTRAP_REPS if reps is None else reps
     condition = condition or study.conditions[0].label
@@ -356,5 +351,5 @@ def plot_training(rows: Sequence[tuple[Any, ...]], path: Path, title: str = "",
     return _save(fig, path)
 
 
-__all__ = ["TAUS", "optimality_score", "plot_comparison", "plot_robustness", "plot_seeds",
+__all__ = ["TAUS", "plot_comparison", "plot_robustness", "plot_seeds",
            "plot_training", "read_curve"]

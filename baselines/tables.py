@@ -4,6 +4,8 @@
 over runs (n) of each score, the nominal start, the compute per step and the training budget.
 ``brake_use_table``: per study with a brake, how each controller uses it (engagements per episode,
 time engaged, first engagement, impulse) and the nominal episode's engaged intervals.
+``improvement_table``: per study, the probability of improvement (rliable) of each trained
+algorithm over every other row but the optimum, in success rate and optimality score.
 ``robustness_table``: per study, one row per controller and one column per condition with the
 success rate (mean over runs) and, over the successes, the time or effort ratio (mean over the
 runs with successes). Both read the rows' aggregates (``baselines.evaluation.aggregate``).
@@ -16,7 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from baselines.records import Episode, Estimate, Row, Study
+from baselines.records import OPTIMAL, Episode, Estimate, Row, Study
 
 
 def interval_text(estimate: Estimate, percent: bool = False) -> str:
@@ -150,6 +152,42 @@ def brake_use_table(studies: Sequence[Study]) -> str:
     return pd.DataFrame(records, columns=columns).to_markdown(index=False) if records else ""
 
 
+def _probability_text(point: float, ci: tuple[float, float] | None) -> str:
+    return f"{point:.2f}" + (f" [{ci[0]:.2f}, {ci[1]:.2f}]" if ci is not None else "")
+
+
+def improvement_table(studies: Sequence[Study], reps: int | None = None) -> str:
+    """P(X > Y) [95 % CI] for each trained row X against each untrained and later trained row Y.
+
+    Per study and condition, over runs: in success rate, and in optimality score (optimum
+    over the run's mean time or effort on its successes, 0 without success;
+    ``aggregate.optimality_score``). The optimal reference's row is not a Y (it is the unit).
+    ``reps``: bootstrap replications (default ``aggregate.BOOTSTRAP_REPS``).
+    """
+    from baselines.aggregate import BOOTSTRAP_REPS, improvement_probability, optimality_score
+
+    reps = BOOTSTRAP_REPS if reps is None else reps
+    records = []
+    for study in studies:
+        ratio = "effort_ratio" if study.objective == "effort" else "time_ratio"
+        for condition in study.conditions:
+            rows = [row for row in study.rows if row.at(condition.label) and row.label != OPTIMAL]
+            scores = {row.label: (
+                [run.scores.success_rate for run in row.at(condition.label)],
+                [optimality_score(getattr(run.scores, ratio)) for run in row.at(condition.label)])
+                for row in rows}  # fmt: skip
+            for i, x in enumerate(rows):
+                others = [y for j, y in enumerate(rows) if j > i or not y.trained]
+                for y in others if x.trained else []:
+                    cells = [_probability_text(*improvement_probability(a, b, reps)) for a, b
+                             in zip(scores[x.label], scores[y.label], strict=True)]  # fmt: skip
+                    records.append([study.env_id.split("/")[-1], study.objective,
+                                    f"{condition.scale:g}", x.label, y.label, *cells])
+    columns = ["env", "objective", "start scale", "X", "Y", "P(X > Y), success [95 % CI]",
+               "P(X > Y), optimality [95 % CI]"]
+    return pd.DataFrame(records, columns=columns).to_markdown(index=False) if records else ""
+
+
 def robustness_table(studies: Sequence[Study]) -> str:
     """Per study a title line and a table: success (ratio over the successes) per condition.
 
@@ -181,4 +219,4 @@ def robustness_table(studies: Sequence[Study]) -> str:
 
 
 __all__ = ["brake_use_table", "budget_text", "comparison_table", "engaged_intervals",
-           "interval_text", "robustness_table"]
+           "improvement_table", "interval_text", "robustness_table"]

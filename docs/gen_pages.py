@@ -27,7 +27,12 @@ import pandas as pd
 
 import mdi_envs  # noqa: F401  (registers the ids)
 from baselines.records import read_study
-from baselines.tables import brake_use_table, comparison_table, robustness_table
+from baselines.tables import (
+    brake_use_table,
+    comparison_table,
+    improvement_table,
+    robustness_table,
+)
 from optimal import available_references, load_reference
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -275,6 +280,14 @@ def comparison_page() -> None:
              "In full (`baselines.tables.comparison_table`): the nominal start, the compute per "
              "policy call and the training budget of each row.", "",
              comparison_table(studies), ""]
+    improvement = improvement_table(studies)
+    if improvement:
+        lines += ["## Probability of improvement", "",
+                  "P(X > Y) of a run of trained algorithm X over a run of row Y (rliable; "
+                  "`baselines.tables.improvement_table`), in success rate and in optimality "
+                  "score (the optimum over the run's mean time or effort on its successes, 0 "
+                  "without success); 0.5 is a tie. Against a heuristic floor it says whether "
+                  "the algorithm beats the floor.", "", improvement, ""]
     brake = brake_use_table(studies)
     if brake:
         lines += ["## Brake use", "",

@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from baselines.aggregate import (
+    improvement_probability,
     iqm_interval,
+    optimality_score,
     performance_profiles,
     sampled_curve,
     success_curve,
@@ -68,3 +70,20 @@ def test_performance_profile_counts_runs_above_tau() -> None:
     assert intervals["a"].shape == (2, 3)
     assert list(profiles) == ["a", "one"] and "one" not in intervals  # one run: no band
     assert profiles["one"] == pytest.approx([1.0, 1.0, 0.0])
+
+
+def test_improvement_probability_is_the_pairwise_win_rate() -> None:
+    # P(X > Y) over all run pairs, ties counted half (the Mann-Whitney U over n m)
+    point, ci = improvement_probability([0.9, 0.8, 0.7], [0.1, 0.2], reps=200)
+    assert point == 1.0 and ci == (1.0, 1.0)
+    assert improvement_probability([1.0, 0.0], [0.5])[0] == 0.5
+    assert improvement_probability([0.4, 0.6], [0.5, 0.6], reps=200)[0] == pytest.approx(
+        (0 + 0 + 1 + 0.5) / 4)  # fmt: skip
+    point, ci = improvement_probability([0.3], [0.2])
+    assert point == 1.0 and ci is None  # one run each: no interval
+    _, ci = improvement_probability([0.1, 0.5, 0.9], [0.2, 0.6], reps=500)
+    assert ci is not None and 0.0 <= ci[0] < ci[1] <= 1.0
+
+
+def test_optimality_score_is_zero_without_success() -> None:
+    assert optimality_score(None) == 0.0 and optimality_score(1.25) == pytest.approx(0.8)

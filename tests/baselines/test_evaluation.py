@@ -39,7 +39,7 @@ from baselines.records import (
     read_study,
     write_study,
 )
-from baselines.tables import brake_use_table, engaged_intervals
+from baselines.tables import brake_use_table, engaged_intervals, improvement_table
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
 from optimal.references import load_reference
 
@@ -120,6 +120,19 @@ def test_brake_use_table_lists_the_brake_rows(manipulator_study: Study, tmp_path
     robot = evaluate(ROBOT, "time", num_starts=1, trained_dir=tmp_path)
     assert robot.row(OPTIMAL).runs[0].episodes[0].brake_use is None
     assert brake_use_table([robot]) == ""
+
+
+def test_improvement_table_pairs_trained_rows_with_the_others(manipulator_study: Study) -> None:
+    rows = [dataclasses.replace(row, trained=row.label == "random")
+            for row in manipulator_study.rows]  # fmt: skip
+    lines = improvement_table([dataclasses.replace(manipulator_study, rows=rows)],
+                              reps=0).splitlines()[2:]  # fmt: skip
+    pairs = [[cell.strip() for cell in line.split("|")[4:8]] for line in lines]
+    others = [row.label for row in rows if row.label not in (OPTIMAL, "random")]
+    assert BANG_BANG in others and "reference controls" in others
+    assert [pair[:2] for pair in pairs] == [["random", label] for label in others]
+    for pair in pairs:  # no CI with one run each; it never reaches the goal
+        assert float(pair[2]) <= 0.5 and float(pair[3]) <= 0.5
 
 
 def test_random_policy_is_reported_as_failure(manipulator_study: Study) -> None:
