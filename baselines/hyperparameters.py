@@ -36,9 +36,11 @@ ALGORITHM_CLASSES = {
     "TQC": "sb3_contrib:TQC",
     "CrossQ": "sb3_contrib:CrossQ",
     "HybridPPO": "baselines.hybrid_ppo:HybridPPO",
+    "DAgger": "baselines.distill:DAgger",
 }
 """Algorithm name -> "module:class" of its SB3-compatible class (imported on use, see
-``baselines.train.algorithm_class``; this module imports no SB3)."""
+``baselines.train.algorithm_class``; this module imports no SB3). ``DAgger`` (the distilled
+policies of ``baselines.distill``, not trained by ``mdi-envs train``) only loads."""
 
 HYPERPARAMS_DIR = Path(__file__).parent / "hyperparams"
 """The shipped rl-zoo3 hyperparameter files (package data)."""

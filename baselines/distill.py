@@ -1,0 +1,415 @@
+"""Distilled policies: DAgger with a model-based controller as the expert (``mdi-envs distill``).
+
+DAgger (S. Ross, G. Gordon, D. Bagnell, "A Reduction of Imitation Learning and Structured
+Prediction to No-Regret Online Learning", AISTATS 2011) trains a network to act as an expert
+controller of ``baselines.model_based`` (``EXPERTS``) on a v1 task, in the expert's own env
+configuration (one env step per transcription interval of the reference):
+
+- round 0, behaviour cloning: the expert plays from the nominal start (the optimal reference's
+  states, labelled with the reference's controls) and from ``episodes`` perturbed starts;
+- rounds 1 ... ``rounds``: episodes from new perturbed starts are played by the mixture that
+  takes the expert's action with probability beta_i = ``beta_decay`` ** i at each step and the
+  learner's otherwise; every visited state is labelled with the expert's action (the expert is
+  called at every step, so its step counter follows the episode), added to the data, and the
+  learner is trained further on all of it.
+
+Perturbed starts draw the start noise half-width ``reset_noise_scale`` log-uniformly in
+``SCALES`` [rad, rad/s, m, m/s] and reset seeds from ``FIRST_TRAINING_SEED`` on, apart from the
+evaluation's seeds 0, 1, ....
+
+The learner is an SB3 policy: ``PPO``'s ``ActorCriticPolicy`` on the robots' Box actions,
+``HybridPPO``'s policy on the manipulator with ``action_mode="hybrid"``, so the brake is a
+discrete choice (the expert's Box action ``[torque, brake]`` becomes the choice
+``brake > 0`` with the same torque: ``expert_label``). The loss is the negative log-likelihood of
+the expert's actions (``policy.evaluate_actions``), minimised by the policy's own optimizer. The
+model is saved with SB3's ``save`` as ``STEM.zip`` beside a ``STEM.json`` ``TrainingRecord``
+(algo ``"DAgger"``) whose ``distillation`` entry (``Distillation``) holds the expert and its label
+budget, so ``baselines.evaluation.load_policy`` and ``mdi-envs compare --trained FOLDER`` play it
+as a trained row; ``DAgger.load`` reads the zip with the class it was saved from.
+
+The field's library, ``imitation`` (BC and DAgger on SB3 policies), does not install beside this
+project: its latest release (1.0.1) pins stable-baselines3 ~2.2.1 and gymnasium 0.29.
+
+``mdi-envs distill mdi_envs/DiffDriveRobot-v1 --seeds 0 1 --output baselines/distilled``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from baselines.datasets import TASKS
+from baselines.evaluation import OBJECTIVES, Controller
+from baselines.model_based import lqr_controller, mpc_controller
+from mdi_envs.provenance import git_commit
+
+EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
+    "lqr": lqr_controller, "mpc": mpc_controller,
+}  # fmt: skip
+"""Expert name -> its ``ControllerFactory`` (``baselines.evaluation``)."""
+
+SCALES = (0.01, 0.1)
+"""The range of the training starts' noise half-width [rad, rad/s, m, m/s] (log-uniform)."""
+
+FIRST_TRAINING_SEED = 1_000_000
+"""Training episodes reset from seeds at or above this (evaluations use 0, 1, ...)."""
+
+ALGO = "DAgger"
+"""The ``algo`` of the records: the row label of the distilled policies."""
+
+DEFAULT_OUTPUT = Path(__file__).parent / "distilled"
+"""Where ``mdi-envs distill`` writes by default (``--trained`` of ``mdi-envs compare``)."""
+
+
+@dataclass(frozen=True)
+class DAggerSettings:
+    """The settings of one distillation.
+
+    Attributes:
+        rounds: DAgger rounds after the behaviour cloning round 0.
+        episodes: perturbed-start episodes per round.
+        beta_decay: beta_i = beta_decay ** i, the expert's share of the actions in round i.
+        gradient_steps: minibatch steps on the aggregated data after each round.
+        batch_size: samples per gradient step.
+        learning_rate: of the policy's Adam optimizer.
+        net_arch: hidden layer widths of the policy (and of its unused value net).
+    """
+
+    rounds: int = 6
+    episodes: int = 20
+    beta_decay: float = 0.5
+    gradient_steps: int = 2000
+    batch_size: int = 256
+    learning_rate: float = 1e-3
+    net_arch: tuple[int, ...] = (128, 128)
+
+    def __post_init__(self) -> None:
+        for name in ("gradient_steps", "batch_size", "episodes"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.rounds < 0:
+            raise ValueError(f"rounds must be >= 0, got {self.rounds}")
+        if not 0.0 <= self.beta_decay < 1.0:
+            raise ValueError(f"beta_decay must be in [0, 1), got {self.beta_decay}")
+        if self.learning_rate <= 0.0 or not self.net_arch or min(self.net_arch) < 1:
+            raise ValueError(f"need learning_rate > 0 and a non-empty net_arch of positive "
+                             f"widths, got {self.learning_rate} and {self.net_arch}")
+
+
+@dataclass(frozen=True)
+class Distillation:
+    """The ``distillation`` entry of a distilled policy's ``STEM.json``.
+
+    Attributes:
+        expert: its name in ``EXPERTS``; expert_label: its row label.
+        settings: the ``DAggerSettings``.
+        expert_calls: labels computed (one per visited state, every round).
+        expert_cpu_s: CPU time [s] of those calls.
+        dataset_sizes: samples after each round (round 0 first).
+        losses: the training loss (``imitation_loss`` on all the data) after each round.
+        learner_success: success rate of each round's episodes (round 0: the expert's).
+    """
+
+    expert: str
+    expert_label: str
+    settings: DAggerSettings
+    expert_calls: int
+    expert_cpu_s: float
+    dataset_sizes: list[int]
+    losses: list[float]
+    learner_success: list[float]
+
+
+def is_hybrid(env_id: str) -> bool:
+    """Whether the learner of ``env_id`` plays ``action_mode="hybrid"`` (a scene with a brake)."""
+    return "Manipulator" in env_id
+
+
+def expert_label(action: np.ndarray, hybrid: bool) -> np.ndarray:
+    """The learner's flat action (float32) for an expert's Box action.
+
+    Box learners take it as is; the hybrid learner's flat action (``baselines.hybrid_ppo``) is
+    ``[brake choice, torque]`` with the choice 1 iff the Box brake component ``action[1] > 0``
+    (the env's "box" rule). ``action``: (2,) [torque / max_torque, brake] when ``hybrid``.
+    """
+    action = np.asarray(action, dtype=np.float32)
+    if not hybrid:
+        return action
+    if action.shape != (2,):
+        raise ValueError(f"a manipulator Box action is (torque, brake), got shape {action.shape}")
+    return np.array([float(action[1] > 0.0), action[0]], dtype=np.float32)
+
+
+def native_action(flat: np.ndarray, hybrid: bool) -> Any:
+    """A flat learner action as the env takes it: the (choice, torques) tuple when ``hybrid``."""
+    from baselines.hybrid_ppo import to_hybrid_actions
+
+    return to_hybrid_actions(flat, 2) if hybrid else flat
+
+
+def learner_env_kwargs(env_id: str, expert: Controller) -> dict[str, Any]:
+    """The ``gym.make`` arguments the learner trains and plays with: the expert's, hybrid brake."""
+    return {**expert.env_kwargs, **({"action_mode": "hybrid"} if is_hybrid(env_id) else {})}
+
+
+def make_learner(env_id: str, env_kwargs: dict[str, Any], settings: DAggerSettings,
+                 seed: int) -> Any:  # fmt: skip
+    """A fresh ``PPO`` (Box actions) or ``HybridPPO`` (hybrid) model whose policy is trained."""
+    from stable_baselines3 import PPO
+
+    from baselines.hybrid_ppo import HybridPPO
+
+    model_class = HybridPPO if is_hybrid(env_id) else PPO
+    return model_class("MlpPolicy", gym.make(env_id, **env_kwargs), seed=seed, device="cpu",
+                       learning_rate=settings.learning_rate,
+                       policy_kwargs={"net_arch": list(settings.net_arch)})  # fmt: skip
+
+
+@dataclass
+class _Labels:
+    """The aggregated data and the expert's budget."""
+
+    observations: list[np.ndarray]
+    actions: list[np.ndarray]
+    calls: int = 0
+    cpu_s: float = 0.0
+
+
+def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, learner: Any,
+                  beta: float, seed: int, rng: np.random.Generator, labels: _Labels) -> bool:
+    """One episode of the beta-mixture from ``reset(seed=seed)``, every state labelled.
+
+    At each step the expert is called (its action is the label); the action played is the
+    expert's with probability ``beta`` and the learner's deterministic one otherwise.
+    ``env_kwargs`` include the start noise. Returns whether the episode ended at the goal.
+    """
+    hybrid = is_hybrid(env_id)
+    env = gym.make(env_id, **env_kwargs)
+    policy = expert.make_policy(env)
+    observation, _ = env.reset(seed=seed)
+    done, info = False, {}
+    while not done:
+        clock = time.process_time()
+        label = expert_label(policy(observation), hybrid)
+        labels.cpu_s += time.process_time() - clock
+        labels.calls += 1
+        labels.observations.append(np.asarray(observation, dtype=np.float32))
+        labels.actions.append(label)
+        flat = label if rng.random() < beta else learner.policy.predict(
+            observation, deterministic=True)[0]  # fmt: skip
+        observation, _, terminated, truncated, info = env.step(native_action(flat, hybrid))
+        done = terminated or truncated
+    env.close()
+    return bool(info.get("is_success", False))
+
+
+def imitation_loss(policy: Any, observations: np.ndarray, actions: np.ndarray) -> float:
+    """Mean negative log-likelihood of ``actions`` (N, a) at ``observations`` (N, d)."""
+    import torch as th
+
+    with th.no_grad():
+        _, log_prob, _ = policy.evaluate_actions(th.as_tensor(observations),
+                                                 th.as_tensor(actions))  # fmt: skip
+    return float(-log_prob.mean())
+
+
+def fit(policy: Any, observations: np.ndarray, actions: np.ndarray, settings: DAggerSettings,
+        rng: np.random.Generator) -> float:  # fmt: skip
+    """``settings.gradient_steps`` Adam steps on the NLL of random minibatches; the final loss.
+
+    The final loss is ``imitation_loss`` over all of ``observations`` (N, d), ``actions`` (N, a).
+    """
+    import torch as th
+
+    policy.set_training_mode(True)
+    obs, act = th.as_tensor(observations), th.as_tensor(actions)
+    for _ in range(settings.gradient_steps):
+        index = th.as_tensor(rng.integers(0, len(obs), settings.batch_size))
+        _, log_prob, _ = policy.evaluate_actions(obs[index], act[index])
+        loss = -log_prob.mean()
+        policy.optimizer.zero_grad()
+        loss.backward()
+        th.nn.utils.clip_grad_norm_(policy.parameters(), 1.0)
+        policy.optimizer.step()
+    policy.set_training_mode(False)
+    return imitation_loss(policy, observations, actions)
+
+
+def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSettings(),
+           seed: int = 0, log: Callable[[str], None] | None = None
+           ) -> tuple[Any, Distillation, dict[str, Any]]:  # fmt: skip
+    """Distil ``expert`` on ``env_id`` (see the module docstring).
+
+    Returns:
+        (the SB3 model whose policy was trained, its ``Distillation``, the learner's
+        ``gym.make`` arguments without the start noise).
+
+    Raises:
+        ValueError: an unknown task or expert, or an expert not available here.
+    """
+    import torch as th
+
+    if env_id not in TASKS:
+        raise ValueError(f"no distillation task {env_id!r}; known: {', '.join(TASKS)}")
+    if expert not in EXPERTS:
+        raise ValueError(f"unknown expert {expert!r}; known: {', '.join(EXPERTS)}")
+    controller = EXPERTS[expert](env_id, OBJECTIVES[env_id][0])
+    if controller is None:
+        raise ValueError(f"expert {expert!r} is not available here (the MPC needs CasADi)")
+    th.set_num_threads(1)  # tiny networks: more threads only add synchronisation
+    th.manual_seed(seed)
+    rng = np.random.default_rng(seed)
+    env_kwargs = learner_env_kwargs(env_id, controller)
+    model = make_learner(env_id, env_kwargs, settings, seed)
+    labels = _Labels([], [])
+    sizes, losses, successes = [], [], []
+    for round_ in range(settings.rounds + 1):
+        beta = settings.beta_decay**round_
+        starts = [(0.0, FIRST_TRAINING_SEED)] if round_ == 0 else []
+        low, high = np.log(SCALES)
+        starts += [(float(np.exp(rng.uniform(low, high))),
+                    int(rng.integers(FIRST_TRAINING_SEED, 2**31)))
+                   for _ in range(settings.episodes)]  # fmt: skip
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            reached = [play_labelled(env_id, {**env_kwargs, "reset_noise_scale": scale}, controller,
+                                     model, beta, reset_seed, rng, labels)
+                       for scale, reset_seed in starts]  # fmt: skip
+        loss = fit(model.policy, np.array(labels.observations), np.array(labels.actions),
+                   settings, rng)  # fmt: skip
+        sizes.append(len(labels.actions))
+        losses.append(loss)
+        successes.append(float(np.mean(reached)))
+        if log is not None:
+            log(f"round {round_}: beta {beta:.3f}, {sizes[-1]} samples, success "
+                f"{successes[-1]:.2f}, loss {loss:.3f}, expert {labels.cpu_s:.1f} s")
+    record = Distillation(expert, controller.label, settings, labels.calls, labels.cpu_s, sizes,
+                          losses, successes)  # fmt: skip
+    return model, record, env_kwargs
+
+
+class DAgger:
+    """The loader of a distilled policy's zip (``ALGORITHM_CLASSES["DAgger"]``)."""
+
+    @staticmethod
+    def load(path: str | Path, device: str = "cpu", **kwargs: Any) -> Any:
+        """The saved model, loaded with its class: ``HybridPPO`` for a hybrid policy, else ``PPO``.
+
+        Raises:
+            ValueError: the zip holds no policy class.
+        """
+        from stable_baselines3 import PPO
+        from stable_baselines3.common.save_util import load_from_zip_file
+
+        from baselines.hybrid_ppo import HybridActorCriticPolicy, HybridPPO
+
+        data, _, _ = load_from_zip_file(path, device=device)
+        policy_class = (data or {}).get("policy_class")
+        if not isinstance(policy_class, type):
+            raise ValueError(f"{path} holds no SB3 policy class")
+        model_class = HybridPPO if issubclass(policy_class, HybridActorCriticPolicy) else PPO
+        return model_class.load(path, device=device, **kwargs)
+
+
+def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSettings(),
+            seed: int = 0, output: Path = DEFAULT_OUTPUT, eval_episodes: int = 10,
+            log: Callable[[str], None] | None = None) -> Path:  # fmt: skip
+    """Run ``dagger`` and write ``STEM.zip`` and ``STEM.json`` into ``output``; the zip's path.
+
+    STEM = ``baselines.train.run_name(env_id, objective, "DAgger", seed)``. The record's
+    ``evaluation`` is ``baselines.train.evaluate`` over ``eval_episodes`` starts at the env's
+    default start noise, from reset seed ``seed + 10_000``.
+    """
+    import torch as th
+
+    from baselines.train import (
+        PolicyEvaluation,
+        RecentEpisodes,
+        TrainingRecord,
+        evaluate,
+        run_name,
+        versions,
+    )
+
+    start = time.perf_counter()
+    model, record, env_kwargs = dagger(env_id, expert, settings, seed, log)
+    wall_time = time.perf_counter() - start
+    objective = OBJECTIVES[env_id][0]
+    output = Path(output)
+    output.mkdir(parents=True, exist_ok=True)
+    stem = run_name(env_id, objective, ALGO, seed)
+    model.save(output / f"{stem}.zip")
+    evaluation: PolicyEvaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed + 10_000)
+    steps = record.expert_calls
+    episodes = (settings.rounds + 1) * settings.episodes + 1
+    training = TrainingRecord(
+        env_id=env_id, objective=objective, algo=ALGO, seed=seed, num_envs=1,
+        total_timesteps=steps, num_timesteps=steps, algo_kwargs=asdict(settings),
+        algo_overrides={}, env_kwargs=env_kwargs, policy="MlpPolicy", device="cpu",
+        torch_threads=th.get_num_threads(), wall_time_s=wall_time, num_episodes=episodes,
+        train_last100=RecentEpisodes(None, record.learner_success[-1]), evaluation=evaluation,
+        versions=versions(), commit=git_commit(), date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        command=f"mdi-envs distill {env_id} --expert {expert} --seeds {seed} --rounds "
+                f"{settings.rounds} --episodes {settings.episodes} "
+                f"--gradient-steps {settings.gradient_steps}")
+    data = {**asdict(training), "distillation": asdict(record)}
+    (output / f"{stem}.json").write_text(json.dumps(data, indent=2, default=str) + "\n")
+    return output / f"{stem}.zip"
+
+
+def add_distill_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``distill`` subcommand to an argparse subparsers object; returns its parser."""
+    defaults = DAggerSettings()
+    parser = subparsers.add_parser(
+        "distill", help="distil a model-based controller into a network by DAgger",
+        description="Train a network policy by DAgger with a model-based controller as the "
+                    "expert; writes STEM.zip and STEM.json per seed into --output (a folder for "
+                    "mdi-envs compare --trained). A seed whose JSON exists is skipped.")
+    parser.add_argument("env_id", choices=TASKS, help="the task")
+    parser.add_argument("--expert", choices=list(EXPERTS), default="lqr", help="default: lqr")
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0], help="default: 0")
+    parser.add_argument("--rounds", type=int, default=defaults.rounds)
+    parser.add_argument("--episodes", type=int, default=defaults.episodes,
+                        help="perturbed starts per round")
+    parser.add_argument("--gradient-steps", type=int, default=defaults.gradient_steps,
+                        help="minibatch steps after each round")
+    parser.add_argument("--output", type=Path, default=DEFAULT_OUTPUT)
+    parser.set_defaults(handler=run_distill)
+    return parser
+
+
+def run_distill(args: argparse.Namespace) -> int:
+    """Handler of ``distill``: one distillation per seed not yet in ``--output``."""
+    from baselines.train import run_name
+
+    try:
+        settings = DAggerSettings(rounds=args.rounds, episodes=args.episodes,
+                                   gradient_steps=args.gradient_steps)
+        for seed in args.seeds:
+            stem = run_name(args.env_id, OBJECTIVES.get(args.env_id, ("",))[0], ALGO, seed)
+            if (args.output / f"{stem}.json").exists():
+                print(f"{stem}: already in {args.output}")
+                continue
+            path = distill(args.env_id, args.expert, settings, seed, args.output,
+                           log=lambda line, s=seed: print(f"seed {s} {line}", flush=True))
+            print(f"{path}")
+    except ValueError as error:
+        raise SystemExit(f"distill: {error}") from error
+    return 0
+
+
+__all__ = [
+    "ALGO", "DEFAULT_OUTPUT", "EXPERTS", "FIRST_TRAINING_SEED", "SCALES", "DAgger",
+    "DAggerSettings", "Distillation", "add_distill_parser", "dagger", "distill", "expert_label",
+    "imitation_loss", "is_hybrid", "learner_env_kwargs", "make_learner", "native_action",
+    "play_labelled",
+]

@@ -1,0 +1,130 @@
+"""DAgger distillation of the LQR.
+
+It imitates the expert better than the untrained network, the saved model plays as a trained
+row, the hybrid brake conversion is exact, bad requests are errors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+pytest.importorskip("stable_baselines3", reason="needs the rl extra")
+
+from baselines.distill import (  # noqa: E402
+    DAggerSettings,
+    _Labels,
+    add_distill_parser,
+    dagger,
+    distill,
+    expert_label,
+    imitation_loss,
+    learner_env_kwargs,
+    make_learner,
+    native_action,
+    play_labelled,
+)
+from baselines.evaluation import (  # noqa: E402
+    DIFF_DRIVE_EFFORT_V1,
+    MANIPULATOR_V1,
+    load_policy,
+    play,
+)
+from baselines.model_based import lqr_controller  # noqa: E402
+
+TINY = DAggerSettings(rounds=1, episodes=2, gradient_steps=400, net_arch=(32, 32))
+
+
+def expert_states(env_id: str, seeds: range, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """(observations, expert labels) of the LQR's own episodes from ``reset(seed=s)``."""
+    expert = lqr_controller(env_id, "effort" if "Effort" in env_id else "time")
+    assert expert is not None
+    labels = _Labels([], [])
+    kwargs = {**learner_env_kwargs(env_id, expert), "reset_noise_scale": scale}
+    for seed in seeds:
+        play_labelled(env_id, kwargs, expert, None, 1.0, seed, np.random.default_rng(0), labels)
+    return np.array(labels.observations), np.array(labels.actions)
+
+
+def test_dagger_imitates_the_expert_on_held_out_states() -> None:
+    model, record, env_kwargs = dagger(DIFF_DRIVE_EFFORT_V1, "lqr", TINY, seed=3)
+    fresh = make_learner(DIFF_DRIVE_EFFORT_V1, env_kwargs, TINY, seed=3)
+    observations, actions = expert_states(DIFF_DRIVE_EFFORT_V1, range(2), 0.05)
+
+    def error(policy: object) -> float:
+        predicted = policy.predict(observations, deterministic=True)[0]  # type: ignore[attr-defined]
+        return float(np.mean(np.abs(predicted - actions)))
+
+    assert imitation_loss(model.policy, observations, actions) < imitation_loss(
+        fresh.policy, observations, actions) - 1.0  # fmt: skip
+    assert error(model.policy) < 0.5 * error(fresh.policy)
+    # every visited state was labelled once: 1 + 2 episodes in round 0, 2 in round 1, 100 steps
+    assert record.expert_calls == record.dataset_sizes[-1] == 5 * 100
+    assert record.dataset_sizes == [300, 500] and record.expert_cpu_s > 0.0
+    assert len(record.losses) == len(record.learner_success) == 2
+
+
+def test_the_distilled_manipulator_loads_and_plays_as_a_trained_row(tmp_path: Path) -> None:
+    settings = DAggerSettings(rounds=0, episodes=1, gradient_steps=50, net_arch=(16,))
+    path = distill(MANIPULATOR_V1, "lqr", settings, seed=1, output=tmp_path, eval_episodes=1)
+    config = json.loads(path.with_suffix(".json").read_text())
+    assert path.name == "BlockableManipulator-v1_time_dagger_seed1.zip"
+    assert config["algo"] == "DAgger" and config["env_kwargs"]["action_mode"] == "hybrid"
+    assert config["distillation"]["expert"] == "lqr"
+    assert config["distillation"]["expert_calls"] == config["num_timesteps"] > 0
+    controller = load_policy(path.with_suffix(".json"))
+    assert controller.label == "DAgger" and controller.training is not None
+    episode = play(MANIPULATOR_V1, controller.make_policy, 0, **controller.env_kwargs)
+    assert episode.num_steps > 0 and episode.brake_use is not None
+    brake, torque = controller.make_policy(None)(np.zeros(7, np.float32))  # type: ignore[arg-type]
+    assert brake in (0, 1) and torque.shape == (1,)
+
+
+def test_the_hybrid_label_plays_exactly_the_experts_box_action() -> None:
+    expert = lqr_controller(MANIPULATOR_V1, "time")
+    assert expert is not None
+    box = gym.make(MANIPULATOR_V1, **expert.env_kwargs, reset_noise_scale=0.05)
+    hybrid = gym.make(MANIPULATOR_V1, **learner_env_kwargs(MANIPULATOR_V1, expert),
+                      reset_noise_scale=0.05)  # fmt: skip
+    policy = expert.make_policy(box)
+    observation, _ = box.reset(seed=4)
+    np.testing.assert_array_equal(hybrid.reset(seed=4)[0], observation)
+    engaged = set()
+    for _ in range(120):
+        action = policy(observation)
+        label = expert_label(action, hybrid=True)
+        engaged.add(int(label[0]))
+        assert label[1] == action[0] and label[0] == float(action[1] > 0)
+        observation, reward, *_ = box.step(action)
+        other, other_reward, *_ = hybrid.step(native_action(label, hybrid=True))
+        np.testing.assert_array_equal(other, observation)
+        assert other_reward == reward
+    assert engaged == {0, 1}  # the reference brakes and releases within these steps
+    np.testing.assert_array_equal(expert_label(np.array([0.5, -1.0]), hybrid=False), [0.5, -1.0])
+
+
+def test_bad_requests_are_errors(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="no distillation task"):
+        dagger("mdi_envs/BlockableManipulator-v0")
+    with pytest.raises(ValueError, match="unknown expert 'optimal'"):
+        dagger(MANIPULATOR_V1, "optimal")
+    with pytest.raises(ValueError, match="gradient_steps must be >= 1"):
+        DAggerSettings(gradient_steps=0)
+    with pytest.raises(ValueError, match="beta_decay must be in"):
+        DAggerSettings(beta_decay=1.0)
+    with pytest.raises(ValueError, match="shape"):
+        expert_label(np.zeros(3), hybrid=True)
+    parser = argparse.ArgumentParser()
+    add_distill_parser(parser.add_subparsers())
+    args = parser.parse_args(["distill", DIFF_DRIVE_EFFORT_V1, "--rounds", "-1",
+                              "--output", str(tmp_path)])  # fmt: skip
+    with pytest.raises(SystemExit, match="distill: rounds must be >= 0"):
+        args.handler(args)
+    (tmp_path / "DiffDriveRobotEffort-v1_effort_dagger_seed0.json").write_text("{}")
+    args = parser.parse_args(["distill", DIFF_DRIVE_EFFORT_V1, "--output", str(tmp_path)])
+    assert args.handler(args) == 0  # the seed is there: nothing is run
