@@ -339,6 +339,7 @@ def test_the_full_fc3d_fallback_steps_as_the_newton_on_friction_impulses() -> No
     through rolling, turning, wheel spin and braking is the same to the solvers' tolerance,
     and both report the same modes.
     """
+    from mdi_envs._kernel_cache import freeze
     from mdi_envs.mechanics.compiled import compile_equations
     from mdi_envs.stepping import _spatial_kernel
     from mdi_envs.stepping._kernel import INFO_ITERATIONS, StepShortcuts
@@ -346,9 +347,10 @@ def test_the_full_fc3d_fallback_steps_as_the_newton_on_friction_impulses() -> No
     stepper = MoreauJeanStepper(DiffDriveRobot, time_step=DT)
     _, record, _ = stepper.compiled_step_batch
     default_step = stepper.compiled_step
-    fallback_step, _ = _spatial_kernel.make_spatial_step_kernels(
+    fallback, _ = _spatial_kernel.make_spatial_step_kernels(
         DiffDriveRobot, compile_equations(DiffDriveRobot), StepShortcuts(),
         load_transfer_max_iter=0)
+    fallback_step = freeze("step_DiffDriveRobot", {"step": fallback})["step"]  # cached on disk
     runs = {}
     for name, step in (("default", default_step), ("fallback", fallback_step)):
         q, u = np.zeros(5), np.zeros(5)
