@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import subprocess
 import sys
 from pathlib import Path
 
@@ -49,23 +48,33 @@ def test_rl_zoo3_resolves_our_entry(key: tuple[str, str, str]) -> None:
 
 
 @pytest.mark.slow
-def test_rl_zoo3_train_uses_our_settings_and_enjoy_plays(tmp_path: Path) -> None:
-    """The README's command, ``-n 2000`` (one 64 x 256 rollout), then ``rl_zoo3.enjoy``."""
+def test_rl_zoo3_train_uses_our_settings_and_enjoy_plays(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The README's command, ``-n 2000`` (one 64 x 256 rollout), then ``rl_zoo3.enjoy``.
+
+    Both run in this process: ``python -m rl_zoo3.train ARGS`` is ``rl_zoo3.train.train()``
+    with ``sys.argv = ["rl_zoo3/train.py", *ARGS]``.
+    """
+    from rl_zoo3.enjoy import enjoy
+    from rl_zoo3.train import train
+
     conf = hyperparameter_file("PPO")
     common = ["--algo", "ppo", "--env", MANIPULATOR, "--gym-packages", "mdi_envs",
               "-f", str(tmp_path)]  # fmt: skip
-    subprocess.run([sys.executable, "-m", "rl_zoo3.train", *common, "-conf", str(conf),
-                    "-n", "2000", "--seed", "0", "--num-threads", "1"],
-                   check=True, capture_output=True, text=True)  # fmt: skip
+    monkeypatch.setattr(sys, "argv", ["rl_zoo3/train.py", *common, "-conf", str(conf),
+                                      "-n", "2000", "--seed", "0", "--num-threads", "1"])
+    train()
     run = tmp_path / "ppo" / "mdi_envs-BlockableManipulator-v0_1"
     saved = yaml.unsafe_load((run / "mdi_envs-BlockableManipulator-v0" / "config.yml").read_text())
     zoo = yaml.safe_load(conf.read_text())[MANIPULATOR]
     assert dict(saved) == zoo  # rl-zoo3's record of the settings it trained with
     assert (run / "mdi_envs-BlockableManipulator-v0.zip").exists()
-    played = subprocess.run([sys.executable, "-m", "rl_zoo3.enjoy", *common, "-n", "600",
-                             "--no-render", "--deterministic"],
-                            check=True, capture_output=True, text=True).stdout  # fmt: skip
-    assert "Episode Length 500" in played  # the untrained arm times out
+    capsys.readouterr()
+    monkeypatch.setattr(sys, "argv", ["rl_zoo3/enjoy.py", *common, "-n", "600", "--no-render",
+                                      "--deterministic"])
+    enjoy()
+    assert "Episode Length 500" in capsys.readouterr().out  # the untrained arm times out
 
 
 @pytest.mark.slow
