@@ -55,12 +55,12 @@ def _model_variant(tmp_path: Path, name: str, old: str, new: str) -> Path:
 
 @pytest.fixture(scope="module")
 def shared_cache(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[dict]]:
-    """An empty cache root filled by three probes started together (they all compile)."""
+    """An empty cache root filled by two probes started together (both compile)."""
     cache = tmp_path_factory.mktemp("kernel_cache")
     processes = [
         subprocess.Popen([sys.executable, str(PROBE), str(OSCILLATOR)], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True, env=_environment(cache))
-        for _ in range(3)
+        for _ in range(2)
     ]
     results = []
     for process in processes:
@@ -175,9 +175,10 @@ def test_the_locator_takes_package_files_only() -> None:
     assert mdi_envs.__version__ == _kernel_cache.__version__
 
 
-# ---- across processes -----------------------------------------------------------------------
+# ---- across processes (slow: they compile into empty caches) -------------------------
 
 
+@pytest.mark.slow
 def test_processes_compiling_together_agree(shared_cache: tuple[Path, list[dict]]) -> None:
     _, results = shared_cache
     assert any(result["misses"] == 3 for result in results)  # the cache started empty
@@ -188,6 +189,7 @@ def test_processes_compiling_together_agree(shared_cache: tuple[Path, list[dict]
         assert result["batch_q"] == [result["q"]] * 3 and result["in_place_q"] == result["q"]
 
 
+@pytest.mark.slow
 def test_a_new_process_loads_instead_of_compiling(shared_cache: tuple[Path, list[dict]]) -> None:
     cache, results = shared_cache
     warm = _probe(cache, OSCILLATOR)
@@ -195,6 +197,7 @@ def test_a_new_process_loads_instead_of_compiling(shared_cache: tuple[Path, list
     assert warm["q"] == results[0]["q"] and warm["u"] == results[0]["u"]
 
 
+@pytest.mark.slow
 def test_an_edited_model_recompiles_with_its_new_equations(
         shared_cache: tuple[Path, list[dict]], tmp_path: Path) -> None:
     cache, results = shared_cache
@@ -209,6 +212,7 @@ def test_an_edited_model_recompiles_with_its_new_equations(
     assert (doubled["q"], doubled["u"]) == (after_edit["q"], after_edit["u"])
 
 
+@pytest.mark.slow
 def test_an_edited_package_recompiles_with_its_new_code(
         shared_cache: tuple[Path, list[dict]], tmp_path: Path) -> None:
     cache, results = shared_cache
@@ -226,13 +230,14 @@ def test_an_edited_package_recompiles_with_its_new_code(
     assert edited["q"] == results[0]["q"]  # the same step, judged differently
 
 
+@pytest.mark.slow
 def test_subproc_vec_env_workers_compiling_together(
         shared_cache: tuple[Path, list[dict]]) -> None:
     # the package's solver kernels are in the shared cache; the ball's step and scene kernels
-    # are not: both workers compile them at once
+    # are not: both workers compile them at once; then one plain process loads what they wrote
     cache, _ = shared_cache
     assert not list(cache.glob("*/kernels/mdi_envs_kernels_scene_BouncingBall*.py"))
-    script = (
+    workers = (
         "import numpy as np, mdi_envs\n"
         "from stable_baselines3.common.env_util import make_vec_env\n"
         "from stable_baselines3.common.vec_env import SubprocVecEnv\n"
@@ -244,9 +249,18 @@ def test_subproc_vec_env_workers_compiling_together(
         "    env.close()\n"
         "    print(repr(obs.tolist()))\n"
     )
+    one_process = (  # the same two copies (seeds 0 and 1, as make_vec_env seeds them)
+        "import gymnasium as gym, numpy as np, mdi_envs\n"
+        "obs = []\n"
+        "for seed in (0, 1):\n"
+        "    env = gym.make('mdi_envs/BouncingBall-v0')\n"
+        "    env.reset(seed=seed)\n"
+        "    obs.append(env.step(np.zeros(1, np.float32))[0])\n"
+        "print(repr(np.array(obs).tolist()))\n"
+    )
     runs = [subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                            env=_environment(cache), timeout=900, check=False)
-            for _ in range(2)]
+            for script in (workers, one_process)]
     for run in runs:
         assert run.returncode == 0, run.stderr[-3000:]
     assert runs[0].stdout == runs[1].stdout  # the second run, from the cache, agrees

@@ -34,6 +34,7 @@ def test_simulate_open_loop_file_and_env_args(
         main(["simulate", "mdi_envs/DiffDriveRobot-v0", "--policy", str(tmp_path / "a.txt")])
 
 
+@pytest.mark.slow  # the whole demo: every reference and shipped policy, played and animated
 def test_demo_shows_envs_references_and_the_comparison(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
