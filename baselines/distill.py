@@ -11,7 +11,12 @@ configuration (one env step per transcription interval of the reference):
   takes the expert's action with probability beta_i = ``beta_decay`` ** i at each step and the
   learner's otherwise; every visited state is labelled with the expert's action (the expert is
   called at every step, so its step counter follows the episode), added to the data, and the
-  learner is trained further on all of it.
+  learner is trained further on all of it (``gradient_steps`` Adam steps on random
+  minibatches, the learning rate decaying from ``learning_rate`` to a tenth in each round).
+
+After each round the learner plays ``validation`` perturbed starts alone (the same starts every
+round); the round whose learner succeeds most often (the later one on a tie) is the policy
+returned, as in Ross et al.'s choice of the best policy on validation.
 
 Perturbed starts draw the start noise half-width ``reset_noise_scale`` log-uniformly in
 ``SCALES`` [rad, rad/s, m, m/s] and reset seeds from ``FIRST_TRAINING_SEED`` on, apart from the
@@ -36,7 +41,9 @@ project: its latest release (1.0.1) pins stable-baselines3 ~2.2.1 and gymnasium 
 from __future__ import annotations
 
 import argparse
+import copy
 import json
+import math
 import time
 import warnings
 from collections.abc import Callable
@@ -46,9 +53,11 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+import torch as th
+from stable_baselines3.common.torch_layers import FlattenExtractor
 
 from baselines.datasets import TASKS
-from baselines.evaluation import OBJECTIVES, Controller
+from baselines.evaluation import OBJECTIVES, Controller, play
 from baselines.model_based import lqr_controller, mpc_controller
 from mdi_envs.provenance import git_commit
 
@@ -82,6 +91,8 @@ class DAggerSettings:
         batch_size: samples per gradient step.
         learning_rate: of the policy's Adam optimizer.
         net_arch: hidden layer widths of the policy (and of its unused value net).
+        validation: perturbed starts the learner plays alone after each round; the round
+            whose learner succeeds most often (the later on a tie) is the one returned.
     """
 
     rounds: int = 6
@@ -90,10 +101,11 @@ class DAggerSettings:
     gradient_steps: int = 2000
     batch_size: int = 256
     learning_rate: float = 1e-3
-    net_arch: tuple[int, ...] = (128, 128)
+    net_arch: tuple[int, ...] = (256, 256)
+    validation: int = 10
 
     def __post_init__(self) -> None:
-        for name in ("gradient_steps", "batch_size", "episodes"):
+        for name in ("gradient_steps", "batch_size", "episodes", "validation"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
         if self.rounds < 0:
@@ -116,7 +128,9 @@ class Distillation:
         expert_cpu_s: CPU time [s] of those calls.
         dataset_sizes: samples after each round (round 0 first).
         losses: the training loss (``imitation_loss`` on all the data) after each round.
-        learner_success: success rate of each round's episodes (round 0: the expert's).
+        mixture_success: success rate of each round's episodes (round 0: the expert's).
+        validation_success: the learner's alone after each round (``DAggerSettings``).
+        best_round: the round whose learner is returned.
     """
 
     expert: str
@@ -126,7 +140,9 @@ class Distillation:
     expert_cpu_s: float
     dataset_sizes: list[int]
     losses: list[float]
-    learner_success: list[float]
+    mixture_success: list[float]
+    validation_success: list[float]
+    best_round: int
 
 
 def is_hybrid(env_id: str) -> bool:
@@ -161,17 +177,45 @@ def learner_env_kwargs(env_id: str, expert: Controller) -> dict[str, Any]:
     return {**expert.env_kwargs, **({"action_mode": "hybrid"} if is_hybrid(env_id) else {})}
 
 
-def make_learner(env_id: str, env_kwargs: dict[str, Any], settings: DAggerSettings,
-                 seed: int) -> Any:  # fmt: skip
-    """A fresh ``PPO`` (Box actions) or ``HybridPPO`` (hybrid) model whose policy is trained."""
+class Standardized(FlattenExtractor):  # type: ignore[misc]
+    """SB3's flattening features extractor, then (obs - mean) / scale with fixed (d,) vectors.
+
+    The learner's inputs mix metres, radians and wheel rates of tens of rad/s; the statistics
+    of the expert's data put them on one scale. They are saved with the model (its
+    ``policy_kwargs`` and buffers).
+    """
+
+    def __init__(self, observation_space: gym.spaces.Box, mean: list[float],
+                 scale: list[float]) -> None:  # fmt: skip
+        super().__init__(observation_space)
+        self.register_buffer("mean", th.as_tensor(mean, dtype=th.float32))
+        self.register_buffer("scale", th.as_tensor(scale, dtype=th.float32))
+
+    def forward(self, observations: th.Tensor) -> th.Tensor:
+        """Standardized features (B, d) of observations (B, d)."""
+        return (super().forward(observations) - self.mean) / self.scale
+
+
+def make_learner(env_id: str, env_kwargs: dict[str, Any], settings: DAggerSettings, seed: int,
+                 observations: np.ndarray) -> Any:  # fmt: skip
+    """A fresh ``PPO`` (Box actions) or ``HybridPPO`` (hybrid) model whose policy is trained.
+
+    ``observations`` (N, d): the data whose mean and standard deviation (1 where it is 0)
+    standardize the policy's inputs (``Standardized``).
+    """
     from stable_baselines3 import PPO
 
     from baselines.hybrid_ppo import HybridPPO
 
+    std = observations.std(axis=0)
+    statistics = {"mean": observations.mean(axis=0).tolist(),
+                  "scale": np.where(std > 1e-6, std, 1.0).tolist()}  # fmt: skip
     model_class = HybridPPO if is_hybrid(env_id) else PPO
     return model_class("MlpPolicy", gym.make(env_id, **env_kwargs), seed=seed, device="cpu",
                        learning_rate=settings.learning_rate,
-                       policy_kwargs={"net_arch": list(settings.net_arch)})  # fmt: skip
+                       policy_kwargs={"net_arch": list(settings.net_arch),
+                                      "features_extractor_class": Standardized,
+                                      "features_extractor_kwargs": statistics})  # fmt: skip
 
 
 @dataclass
@@ -214,8 +258,6 @@ def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, l
 
 def imitation_loss(policy: Any, observations: np.ndarray, actions: np.ndarray) -> float:
     """Mean negative log-likelihood of ``actions`` (N, a) at ``observations`` (N, d)."""
-    import torch as th
-
     with th.no_grad():
         _, log_prob, _ = policy.evaluate_actions(th.as_tensor(observations),
                                                  th.as_tensor(actions))  # fmt: skip
@@ -226,13 +268,16 @@ def fit(policy: Any, observations: np.ndarray, actions: np.ndarray, settings: DA
         rng: np.random.Generator) -> float:  # fmt: skip
     """``settings.gradient_steps`` Adam steps on the NLL of random minibatches; the final loss.
 
+    The learning rate decays as a cosine from ``settings.learning_rate`` to a tenth of it.
+
     The final loss is ``imitation_loss`` over all of ``observations`` (N, d), ``actions`` (N, a).
     """
-    import torch as th
-
     policy.set_training_mode(True)
     obs, act = th.as_tensor(observations), th.as_tensor(actions)
-    for _ in range(settings.gradient_steps):
+    for step in range(settings.gradient_steps):
+        decay = 0.55 + 0.45 * math.cos(math.pi * step / settings.gradient_steps)
+        for group in policy.optimizer.param_groups:
+            group["lr"] = settings.learning_rate * decay
         index = th.as_tensor(rng.integers(0, len(obs), settings.batch_size))
         _, log_prob, _ = policy.evaluate_actions(obs[index], act[index])
         loss = -log_prob.mean()
@@ -242,6 +287,18 @@ def fit(policy: Any, observations: np.ndarray, actions: np.ndarray, settings: DA
         policy.optimizer.step()
     policy.set_training_mode(False)
     return imitation_loss(policy, observations, actions)
+
+
+def learner_policy(model: Any) -> Callable[[Any], Callable[[Any], Any]]:
+    """The ``Controller.make_policy`` of a model: its deterministic ``predict``."""
+    return lambda _env: lambda observation: model.predict(observation, deterministic=True)[0]
+
+
+def perturbed_starts(rng: np.random.Generator, count: int) -> list[tuple[float, int]]:
+    """``count`` (start noise half-width log-uniform in ``SCALES``, reset seed) pairs."""
+    low, high = np.log(SCALES)
+    return [(float(np.exp(rng.uniform(low, high))),
+             int(rng.integers(FIRST_TRAINING_SEED, 2**31))) for _ in range(count)]  # fmt: skip
 
 
 def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSettings(),
@@ -256,8 +313,6 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
     Raises:
         ValueError: an unknown task or expert, or an expert not available here.
     """
-    import torch as th
-
     if env_id not in TASKS:
         raise ValueError(f"no distillation task {env_id!r}; known: {', '.join(TASKS)}")
     if expert not in EXPERTS:
@@ -269,31 +324,39 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
     th.manual_seed(seed)
     rng = np.random.default_rng(seed)
     env_kwargs = learner_env_kwargs(env_id, controller)
-    model = make_learner(env_id, env_kwargs, settings, seed)
+    model: Any = None  # made after round 0, whose expert data give the observation statistics
     labels = _Labels([], [])
-    sizes, losses, successes = [], [], []
+    validation = perturbed_starts(rng, settings.validation)
+    sizes, losses, mixture, validated = [], [], [], []
+    best, best_round = None, 0
     for round_ in range(settings.rounds + 1):
         beta = settings.beta_decay**round_
         starts = [(0.0, FIRST_TRAINING_SEED)] if round_ == 0 else []
-        low, high = np.log(SCALES)
-        starts += [(float(np.exp(rng.uniform(low, high))),
-                    int(rng.integers(FIRST_TRAINING_SEED, 2**31)))
-                   for _ in range(settings.episodes)]  # fmt: skip
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             reached = [play_labelled(env_id, {**env_kwargs, "reset_noise_scale": scale}, controller,
                                      model, beta, reset_seed, rng, labels)
-                       for scale, reset_seed in starts]  # fmt: skip
-        loss = fit(model.policy, np.array(labels.observations), np.array(labels.actions),
-                   settings, rng)  # fmt: skip
+                       for scale, reset_seed in starts + perturbed_starts(rng, settings.episodes)]
+            if model is None:
+                model = make_learner(env_id, env_kwargs, settings, seed,
+                                     np.array(labels.observations))  # fmt: skip
+            losses.append(fit(model.policy, np.array(labels.observations),
+                              np.array(labels.actions), settings, rng))  # fmt: skip
+            validated.append(float(np.mean([
+                play(env_id, learner_policy(model), reset_seed,
+                     **{**env_kwargs, "reset_noise_scale": scale}).is_success
+                for scale, reset_seed in validation])))  # fmt: skip
         sizes.append(len(labels.actions))
-        losses.append(loss)
-        successes.append(float(np.mean(reached)))
+        mixture.append(float(np.mean(reached)))
+        if best is None or validated[-1] >= validated[best_round]:
+            best, best_round = copy.deepcopy(model.policy.state_dict()), round_
         if log is not None:
-            log(f"round {round_}: beta {beta:.3f}, {sizes[-1]} samples, success "
-                f"{successes[-1]:.2f}, loss {loss:.3f}, expert {labels.cpu_s:.1f} s")
+            log(f"round {round_}: beta {beta:.3f}, {sizes[-1]} samples, loss {losses[-1]:.3f}, "
+                f"success of the mixture {mixture[-1]:.2f}, of the learner {validated[-1]:.2f}, "
+                f"expert {labels.cpu_s:.1f} s")
+    model.policy.load_state_dict(best)
     record = Distillation(expert, controller.label, settings, labels.calls, labels.cpu_s, sizes,
-                          losses, successes)  # fmt: skip
+                          losses, mixture, validated, best_round)  # fmt: skip
     return model, record, env_kwargs
 
 
@@ -329,8 +392,6 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
     ``evaluation`` is ``baselines.train.evaluate`` over ``eval_episodes`` starts at the env's
     default start noise, from reset seed ``seed + 10_000``.
     """
-    import torch as th
-
     from baselines.train import (
         PolicyEvaluation,
         RecentEpisodes,
@@ -356,7 +417,7 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
         total_timesteps=steps, num_timesteps=steps, algo_kwargs=asdict(settings),
         algo_overrides={}, env_kwargs=env_kwargs, policy="MlpPolicy", device="cpu",
         torch_threads=th.get_num_threads(), wall_time_s=wall_time, num_episodes=episodes,
-        train_last100=RecentEpisodes(None, record.learner_success[-1]), evaluation=evaluation,
+        train_last100=RecentEpisodes(None, record.mixture_success[-1]), evaluation=evaluation,
         versions=versions(), commit=git_commit(), date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         command=f"mdi-envs distill {env_id} --expert {expert} --seeds {seed} --rounds "
                 f"{settings.rounds} --episodes {settings.episodes} "

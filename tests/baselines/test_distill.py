@@ -37,7 +37,7 @@ from baselines.evaluation import (  # noqa: E402
 )
 from baselines.model_based import lqr_controller  # noqa: E402
 
-TINY = DAggerSettings(rounds=1, episodes=2, gradient_steps=400, net_arch=(32, 32))
+TINY = DAggerSettings(rounds=1, episodes=2, gradient_steps=400, net_arch=(32, 32), validation=1)
 
 
 def expert_states(env_id: str, seeds: range, scale: float) -> tuple[np.ndarray, np.ndarray]:
@@ -53,8 +53,8 @@ def expert_states(env_id: str, seeds: range, scale: float) -> tuple[np.ndarray, 
 
 def test_dagger_imitates_the_expert_on_held_out_states() -> None:
     model, record, env_kwargs = dagger(DIFF_DRIVE_EFFORT_V1, "lqr", TINY, seed=3)
-    fresh = make_learner(DIFF_DRIVE_EFFORT_V1, env_kwargs, TINY, seed=3)
     observations, actions = expert_states(DIFF_DRIVE_EFFORT_V1, range(2), 0.05)
+    fresh = make_learner(DIFF_DRIVE_EFFORT_V1, env_kwargs, TINY, 3, observations)
 
     def error(policy: object) -> float:
         predicted = policy.predict(observations, deterministic=True)[0]  # type: ignore[attr-defined]
@@ -66,11 +66,12 @@ def test_dagger_imitates_the_expert_on_held_out_states() -> None:
     # every visited state was labelled once: 1 + 2 episodes in round 0, 2 in round 1, 100 steps
     assert record.expert_calls == record.dataset_sizes[-1] == 5 * 100
     assert record.dataset_sizes == [300, 500] and record.expert_cpu_s > 0.0
-    assert len(record.losses) == len(record.learner_success) == 2
+    assert len(record.losses) == len(record.mixture_success) == len(record.validation_success) == 2
+    assert record.best_round in (0, 1)
 
 
 def test_the_distilled_manipulator_loads_and_plays_as_a_trained_row(tmp_path: Path) -> None:
-    settings = DAggerSettings(rounds=0, episodes=1, gradient_steps=50, net_arch=(16,))
+    settings = DAggerSettings(rounds=0, episodes=1, gradient_steps=50, net_arch=(16,), validation=1)
     path = distill(MANIPULATOR_V1, "lqr", settings, seed=1, output=tmp_path, eval_episodes=1)
     config = json.loads(path.with_suffix(".json").read_text())
     assert path.name == "BlockableManipulator-v1_time_dagger_seed1.zip"
