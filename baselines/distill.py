@@ -35,6 +35,9 @@ as a trained row; ``DAgger.load`` reads the zip with the class it was saved from
 The field's library, ``imitation`` (BC and DAgger on SB3 policies), does not install beside this
 project: its latest release (1.0.1) pins stable-baselines3 ~2.2.1 and gymnasium 0.29.
 
+The labelled episodes can also be written as a Minari dataset (``write_labels``, ``--dataset``):
+the visited observations with the expert's actions, the imitation data of the run.
+
 ``mdi-envs distill mdi_envs/DiffDriveRobot-v1 --seeds 0 1 --output baselines/distilled``.
 """
 
@@ -44,10 +47,11 @@ import argparse
 import copy
 import json
 import math
+import os
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -56,7 +60,7 @@ import numpy as np
 import torch as th
 from stable_baselines3.common.torch_layers import FlattenExtractor
 
-from baselines.datasets import TASKS
+from baselines.datasets import TASKS, dataset_id
 from baselines.evaluation import OBJECTIVES, Controller, play
 from baselines.model_based import lqr_controller, mpc_controller
 from mdi_envs.provenance import git_commit
@@ -226,6 +230,9 @@ class _Labels:
     actions: list[np.ndarray]
     calls: int = 0
     cpu_s: float = 0.0
+    episodes: list[dict[str, Any]] = field(default_factory=list)
+    """Per episode: its reset seed, observations (T + 1), the expert's Box actions (T) and
+    the rewards, terminations and truncations (T) as played."""
 
 
 def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, learner: Any,
@@ -241,17 +248,25 @@ def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, l
     policy = expert.make_policy(env)
     observation, _ = env.reset(seed=seed)
     done, info = False, {}
+    episode: dict[str, Any] = {"seed": seed, "observations": [observation], "actions": [],
+                               "rewards": [], "terminations": [], "truncations": []}
     while not done:
         clock = time.process_time()
-        label = expert_label(policy(observation), hybrid)
+        action = policy(observation)
         labels.cpu_s += time.process_time() - clock
+        label = expert_label(action, hybrid)
         labels.calls += 1
         labels.observations.append(np.asarray(observation, dtype=np.float32))
         labels.actions.append(label)
         flat = label if rng.random() < beta else learner.policy.predict(
             observation, deterministic=True)[0]  # fmt: skip
-        observation, _, terminated, truncated, info = env.step(native_action(flat, hybrid))
+        observation, reward, terminated, truncated, info = env.step(native_action(flat, hybrid))
         done = terminated or truncated
+        for key, value in (("observations", observation), ("actions", action),
+                           ("rewards", reward), ("terminations", terminated),
+                           ("truncations", truncated)):  # fmt: skip
+            episode[key].append(value)
+    labels.episodes.append(episode)
     env.close()
     return bool(info.get("is_success", False))
 
@@ -302,9 +317,12 @@ def perturbed_starts(rng: np.random.Generator, count: int) -> list[tuple[float, 
 
 
 def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSettings(),
-           seed: int = 0, log: Callable[[str], None] | None = None
+           seed: int = 0, log: Callable[[str], None] | None = None, dataset: str | None = None
            ) -> tuple[Any, Distillation, dict[str, Any]]:  # fmt: skip
     """Distil ``expert`` on ``env_id`` (see the module docstring).
+
+    With ``dataset`` (a Minari dataset id) every labelled episode is also written as a Minari
+    dataset (``write_labels``).
 
     Returns:
         (the SB3 model whose policy was trained, its ``Distillation``, the learner's
@@ -357,7 +375,35 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
     model.policy.load_state_dict(best)
     record = Distillation(expert, controller.label, settings, labels.calls, labels.cpu_s, sizes,
                           losses, mixture, validated, best_round)  # fmt: skip
+    if dataset is not None:
+        write_labels(env_id, controller, labels.episodes, dataset,
+                     f"DAgger seed {seed}, expert {controller.label}, {settings}")  # fmt: skip
     return model, record, env_kwargs
+
+
+def write_labels(env_id: str, expert: Controller, episodes: list[dict[str, Any]], dataset: str,
+                 description: str) -> Any:  # fmt: skip
+    """The DAgger-labelled episodes as the Minari dataset ``dataset``; returns it.
+
+    Each episode's observations are those visited (the mixture's actions moved the state),
+    its actions the expert's labels in the expert's own Box action space: the pairs
+    (observation, action) are the imitation data, the transitions are not replayable by the
+    actions. The env spec is the expert's configuration (``Controller.env_kwargs``).
+    """
+    import minari
+    from minari.data_collector.episode_buffer import EpisodeBuffer
+
+    buffers = [EpisodeBuffer(id=index, seed=episode["seed"],
+                             observations=np.array(episode["observations"], np.float32),
+                             actions=np.array(episode["actions"], np.float32),
+                             rewards=episode["rewards"], terminations=episode["terminations"],
+                             truncations=episode["truncations"])
+               for index, episode in enumerate(episodes)]  # fmt: skip
+    env = gym.make(env_id, **expert.env_kwargs)
+    return minari.create_dataset_from_buffers(
+        dataset, buffers, env=env, eval_env=env, algorithm_name="DAgger",
+        author="mdi-envs", code_permalink=f"baselines/distill.py at commit {git_commit()}",
+        description=f"{description}. Observations as visited, actions the expert's labels.")
 
 
 class DAgger:
@@ -385,8 +431,11 @@ class DAgger:
 
 def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSettings(),
             seed: int = 0, output: Path = DEFAULT_OUTPUT, eval_episodes: int = 10,
-            log: Callable[[str], None] | None = None) -> Path:  # fmt: skip
+            log: Callable[[str], None] | None = None, dataset: str | None = None
+            ) -> Path:  # fmt: skip
     """Run ``dagger`` and write ``STEM.zip`` and ``STEM.json`` into ``output``; the zip's path.
+
+    ``dataset``: the Minari dataset id of the labelled episodes (None: none written).
 
     STEM = ``baselines.train.run_name(env_id, objective, "DAgger", seed)``. The record's
     ``evaluation`` is ``baselines.train.evaluate`` over ``eval_episodes`` starts at the env's
@@ -402,7 +451,7 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
     )
 
     start = time.perf_counter()
-    model, record, env_kwargs = dagger(env_id, expert, settings, seed, log)
+    model, record, env_kwargs = dagger(env_id, expert, settings, seed, log, dataset)
     wall_time = time.perf_counter() - start
     objective = OBJECTIVES[env_id][0]
     output = Path(output)
@@ -444,6 +493,11 @@ def add_distill_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument("--gradient-steps", type=int, default=defaults.gradient_steps,
                         help="minibatch steps after each round")
     parser.add_argument("--output", type=Path, default=DEFAULT_OUTPUT)
+    parser.add_argument("--dataset", action="store_true",
+                        help="also write each seed's labelled episodes as the Minari dataset "
+                             "mdi_envs/<Task>/dagger-<expert>-seed<seed>-v0")
+    parser.add_argument("--root", type=Path, default=None,
+                        help="the datasets' folder (sets MINARI_DATASETS_PATH)")
     parser.set_defaults(handler=run_distill)
     return parser
 
@@ -452,6 +506,8 @@ def run_distill(args: argparse.Namespace) -> int:
     """Handler of ``distill``: one distillation per seed not yet in ``--output``."""
     from baselines.train import run_name
 
+    if args.root is not None:
+        os.environ["MINARI_DATASETS_PATH"] = str(args.root.resolve())
     try:
         settings = DAggerSettings(rounds=args.rounds, episodes=args.episodes,
                                    gradient_steps=args.gradient_steps)
@@ -460,8 +516,10 @@ def run_distill(args: argparse.Namespace) -> int:
             if (args.output / f"{stem}.json").exists():
                 print(f"{stem}: already in {args.output}")
                 continue
+            dataset = dataset_id(args.env_id, f"dagger-{args.expert}-seed{seed}")
             path = distill(args.env_id, args.expert, settings, seed, args.output,
-                           log=lambda line, s=seed: print(f"seed {s} {line}", flush=True))
+                           log=lambda line, s=seed: print(f"seed {s} {line}", flush=True),
+                           dataset=dataset if args.dataset else None)  # fmt: skip
             print(f"{path}")
     except ValueError as error:
         raise SystemExit(f"distill: {error}") from error
@@ -470,7 +528,7 @@ def run_distill(args: argparse.Namespace) -> int:
 
 __all__ = [
     "ALGO", "DEFAULT_OUTPUT", "EXPERTS", "FIRST_TRAINING_SEED", "SCALES", "DAgger",
-    "DAggerSettings", "Distillation", "add_distill_parser", "dagger", "distill", "expert_label",
-    "imitation_loss", "is_hybrid", "learner_env_kwargs", "make_learner", "native_action",
-    "play_labelled",
+    "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill", "expert_label",
+    "imitation_loss", "is_hybrid", "learner_env_kwargs", "learner_policy", "make_learner",
+    "native_action", "perturbed_starts", "play_labelled", "write_labels",
 ]

@@ -51,8 +51,12 @@ def expert_states(env_id: str, seeds: range, scale: float) -> tuple[np.ndarray, 
     return np.array(labels.observations), np.array(labels.actions)
 
 
-def test_dagger_imitates_the_expert_on_held_out_states() -> None:
-    model, record, env_kwargs = dagger(DIFF_DRIVE_EFFORT_V1, "lqr", TINY, seed=3)
+def test_dagger_imitates_the_expert_on_held_out_states(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    minari = pytest.importorskip("minari", reason="minari is in the datasets extra")
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path))
+    name = "mdi_envs/DiffDriveRobotEffort/dagger-lqr-seed3-v0"
+    model, record, env_kwargs = dagger(DIFF_DRIVE_EFFORT_V1, "lqr", TINY, seed=3, dataset=name)
     observations, actions = expert_states(DIFF_DRIVE_EFFORT_V1, range(2), 0.05)
     fresh = make_learner(DIFF_DRIVE_EFFORT_V1, env_kwargs, TINY, 3, observations)
 
@@ -68,6 +72,15 @@ def test_dagger_imitates_the_expert_on_held_out_states() -> None:
     assert record.dataset_sizes == [300, 500] and record.expert_cpu_s > 0.0
     assert len(record.losses) == len(record.mixture_success) == len(record.validation_success) == 2
     assert record.best_round in (0, 1)
+    # the labelled episodes as a Minari dataset: a fresh expert relabels them identically
+    dataset = minari.load_dataset(name)
+    assert dataset.total_episodes == 5 and dataset.total_steps == record.expert_calls
+    expert = lqr_controller(DIFF_DRIVE_EFFORT_V1, "effort")
+    assert expert is not None
+    for episode in dataset.iterate_episodes():
+        policy = expert.make_policy(None)  # type: ignore[arg-type]
+        relabelled = [policy(observation) for observation in episode.observations[:-1]]
+        np.testing.assert_array_equal(relabelled, episode.actions)
 
 
 def test_the_distilled_manipulator_loads_and_plays_as_a_trained_row(tmp_path: Path) -> None:
