@@ -528,7 +528,7 @@ def run_distill(args: argparse.Namespace) -> int:
 
 __all__ = [
     "ALGO", "DEFAULT_OUTPUT", "EXPERTS", "FIRST_TRAINING_SEED", "SCALES", "DAgger",
-    "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill", "expert_label",
-    "imitation_loss", "is_hybrid", "learner_env_kwargs", "learner_policy", "make_learner",
-    "native_action", "perturbed_starts", "play_labelled", "write_labels",
+    "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill",
+    "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs", "learner_policy",
+    "make_learner", "native_action", "perturbed_starts", "play_labelled", "write_labels",
 ]
