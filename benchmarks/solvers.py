@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from benchmarks import entries as E
 from benchmarks import report, timing
@@ -184,19 +185,13 @@ def _median(values: Iterable[float]) -> float:
 
 def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """Combine the instances of each (family, n, entry) of the work-size study."""
-    groups: dict[tuple[str, int, str], list[dict[str, Any]]] = {}
-    for record in records:
-        groups.setdefault((record["family"], record["n"], record["entry"]), []).append(record)
-    rows = []
-    for (family, n, entry), group in groups.items():
-        times = [r["time"]["median_s"] for r in group]
-        rows.append({
-            "family": family, "n": n, "entry": entry, "time_median_s": _median(times),
-            "time_min_s": min(times), "time_max_s": max(times),
-            "residual_max": max(r["outcome"]["residual"] for r in group),
-            "iterations_median": _median(r["outcome"]["iterations"] for r in group),
-            "solved": sum(r["outcome"]["success"] for r in group), "instances": len(group)})
-    return rows
+    frame = pd.json_normalize(list(records))
+    rows = frame.groupby(["family", "n", "entry"], sort=False).agg(
+        time_median_s=("time.median_s", "median"), time_min_s=("time.median_s", "min"),
+        time_max_s=("time.median_s", "max"), residual_max=("outcome.residual", "max"),
+        iterations_median=("outcome.iterations", "median"), solved=("outcome.success", "sum"),
+        instances=("entry", "size"))
+    return rows.reset_index().astype(object).to_dict("records")
 
 
 def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:

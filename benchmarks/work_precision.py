@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 import textwrap
 import time
-import timeit
 import traceback
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -154,18 +153,12 @@ class Context:
     _compiled: set[tuple[str, str]] = field(default_factory=set)
 
     def timed(self, call: Callable[[], Any]) -> tuple[float, int, Any]:
-        """(best wall time [s] of ``call()``, repeats, the untimed warm-up call's result).
+        """(fastest wall time [s] of ``call()``, timed calls, the untimed warm-up call's result).
 
-        As many timed calls (``timeit``, GC on) as fit in the plan's budget by the warm-up's
-        duration, within its least and most rounds.
+        ``timing.time_interleaved`` with the run's plan, one callable.
         """
-        plan, start = self.config.timing, time.perf_counter()
-        result = call()
-        first = time.perf_counter() - start
-        fits = int(plan.budget_s / max(first, 1e-9))
-        repeats = min(plan.max_rounds, max(plan.min_rounds, 1, fits))
-        timer = timeit.Timer(call, setup="gc.enable()")
-        return min(timer.repeat(repeat=repeats, number=1)), repeats, result
+        t = timing.time_interleaved({"call": call}, self.config.timing)["call"]
+        return t.min_s, t.rounds * t.number, t.result
 
     def stepper(self, model: Any, parameters: Any, dt: float, method: str = "enumerative",
                 locate_impacts: bool = False) -> MoreauJeanStepper:
@@ -793,15 +786,12 @@ def pareto_front(points: Sequence[Mapping[str, Any]]) -> list[tuple[float, float
 def interpolate_front(front: Sequence[tuple[float, float, str]], seconds: float
                       ) -> tuple[float | None, str]:
     """MuJoCo's error at ``seconds`` on its front (see ``equal_time_comparison``)."""
-    times = [f[0] for f in front]
-    if seconds <= times[0]:
+    times, errors = np.log([f[:2] for f in front]).T
+    if seconds <= front[0][0]:
         return front[0][1], "clamped"
-    if seconds > times[-1]:
+    if seconds > front[-1][0]:
         return None, "beyond"
-    i = int(np.searchsorted(times, seconds))
-    (t0, e0, _), (t1, e1, _) = front[i - 1], front[i]
-    w = math.log(seconds / t0) / math.log(t1 / t0)
-    return math.exp((1.0 - w) * math.log(e0) + w * math.log(e1)), "interpolated"
+    return math.exp(np.interp(math.log(seconds), times, errors)), "interpolated"
 
 
 def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
