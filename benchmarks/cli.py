@@ -26,6 +26,8 @@ BENCHMARKS = {  # NAME: (module with ``main(argv)``, what it measures)
     "fc3d": ("benchmarks.fc3d", "every FC3D method on the Siconos fc3d peer problems"),
     "stress": ("benchmarks.stress", "the stress cases of tests/stress with their criteria"),
     "startup": ("benchmarks.startup", "interpreter start to the first env step, warm and cold"),
+    "control": ("benchmarks.control", "model-based controllers: compute per step over the control "
+                "period, success and cost from perturbed starts"),
 }
 DEFAULT_OUTPUT = Path("benchmarks/results")
 """Where the full run writes (committed); ``--quick`` writes into its ``quick/`` subfolder."""

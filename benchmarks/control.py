@@ -1,0 +1,176 @@
+"""Model-based controllers in real time (``mdi-envs bench control``): compute, success, cost.
+
+Each controller row of ``baselines.model_based`` plays every optimal reference's task
+(``baselines.evaluation.REFERENCE_NAMES``) from perturbed starts (``reset(seed=s)`` at each
+``SCALES`` half-width) in the env configured like the comparison. The compute of each control
+step is CPU time (``time.process_time`` around the policy call), so other processes on the
+machine do not inflate it; the real-time factor is that time over the control period (the env's
+dt, the reference's h): at most 1 means the controller keeps up with the plant. Reported per row:
+the real-time factor's median, 95th percentile and worst over all steps of all episodes; the
+success rate; the time (time tasks) or effort (effort task) over the reference's, mean over the
+successes. The shrinking-horizon MPC takes seconds per step: it plays ``SLOW_STARTS`` starts
+per scale and is left out of ``--quick``. ``--controllers`` plays some rows and keeps the others
+of an existing ``control.json`` (each record carries its date). Writes ``control.json`` and
+``control.png``.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+import warnings
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from baselines.evaluation import REFERENCE_NAMES, Controller, reference_effort
+from baselines.model_based import lqr_controller, mpc_controller
+from benchmarks import report
+from benchmarks.timing import Progress, arguments, finish, machine_info
+from optimal.references import load_reference
+
+CONTROLLERS: dict[str, Callable[[str, str], Controller | None]] = {
+    "lqr": lqr_controller, "shrinking": mpc_controller}
+"""Row key -> the ``ControllerFactory`` it plays."""
+
+SLOW = ("shrinking",)
+"""Rows that play ``SLOW_STARTS`` starts and are left out of ``--quick``."""
+
+SCALES = (0.01, 0.1)
+"""Start perturbation half-widths [rad, rad/s, m, m/s]."""
+
+STARTS, SLOW_STARTS, QUICK_STARTS = 20, 3, 2
+"""Perturbed starts per scale: fast rows, ``SLOW`` rows, every row under ``--quick``."""
+
+TARGET_RTF, TARGET_SUCCESS, TARGET_RATIO = 1.0, 0.95, 1.01
+"""Targets per task and scale: median real-time factor, success rate, cost over the optimum."""
+
+
+def play(controller: Controller, env_id: str, scale: float, seed: int) -> dict[str, Any]:
+    """One episode from ``reset(seed=seed)``: its end ``info`` and each step's CPU time [s]."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make(env_id, **{**controller.env_kwargs, "reset_noise_scale": scale})
+    policy = controller.make_policy(env)
+    observation, _ = env.reset(seed=seed)
+    compute: list[float] = []
+    while True:
+        clock = time.process_time()
+        action = policy(observation)
+        compute.append(time.process_time() - clock)
+        observation, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            env.close()
+            return {"info": info, "compute": compute}
+
+
+def measure(key: str, env_id: str, objective: str, starts: int,
+            progress: Progress) -> list[dict[str, Any]]:
+    """One record per scale of the row ``key`` on the task (env id, objective)."""
+    controller = CONTROLLERS[key](env_id, objective)
+    if controller is None:
+        return []
+    reference = load_reference(REFERENCE_NAMES[(env_id, objective)])
+    optimum = reference.final_time if objective == "time" else reference_effort(reference)
+    records = []
+    for scale in SCALES:
+        episodes = []
+        for seed in range(starts):
+            episodes.append(play(controller, env_id, scale, seed))
+            progress(f"{key} {reference.name} scale {scale} seed {seed}: "
+                     f"{'success' if episodes[-1]['info']['is_success'] else 'failure'}")
+        steps = np.concatenate([e["compute"] for e in episodes]) / reference.time_step
+        success = [bool(e["info"]["is_success"]) for e in episodes]
+        cost = "elapsed_time" if objective == "time" else "effort"
+        ratios = [e["info"][cost] / optimum for e, ok in zip(episodes, success, strict=True) if ok]
+        records.append({
+            "controller": key, "label": controller.label, "task": reference.name,
+            "scale": scale, "starts": starts, "control_period_s": reference.time_step,
+            "rtf_median": float(np.median(steps)), "rtf_p95": float(np.percentile(steps, 95)),
+            "rtf_worst": float(np.max(steps)), "success_rate": float(np.mean(success)),
+            "ratio": float(np.mean(ratios)) if ratios else None,
+            "ratios": [float(r) for r in ratios], "date": time.strftime("%Y-%m-%d %H:%M UTC",
+                                                                           time.gmtime())})
+    return records
+
+
+def targets(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per fast row, task and scale: real-time factor, success and cost ratio checks."""
+    rows = []
+    for r in records:
+        if r["controller"] in SLOW:
+            continue
+        name = f"{r['label']}, {r['task']} at {r['scale']:g}"
+        rows += [report.target_row(f"{name}: real-time factor, median", "≤", TARGET_RTF, "×",
+                                   r["rtf_median"], f"p95 {r['rtf_p95']:.3g}, worst "
+                                   f"{r['rtf_worst']:.3g}"),
+                 report.target_row(f"{name}: success", "≥", TARGET_SUCCESS, "",
+                                   r["success_rate"], f"{r['starts']} starts"),
+                 report.target_row(f"{name}: cost / optimum", "≤", TARGET_RATIO, "×",
+                                   r["ratio"])]
+    return rows
+
+
+def plot(records: Sequence[dict[str, Any]], path: Path) -> None:
+    """Real-time factor (median and worst) and success per row, task and scale."""
+    labels = [f"{r['task']} {r['scale']:g}" for r in records if r["controller"] == "lqr"]
+    fig, axes = report.plt.subplots(1, 2, figsize=(11, 4.5))
+    series_rtf: dict[str, list[float | None]] = {}
+    series_success: dict[str, list[float | None]] = {}
+    for key in dict.fromkeys(r["controller"] for r in records):
+        by_case = {f"{r['task']} {r['scale']:g}": r for r in records if r["controller"] == key}
+        label = next(r["label"] for r in records if r["controller"] == key)
+        for stat in ("median", "worst"):
+            series_rtf[f"{label} {stat}"] = [by_case[c][f"rtf_{stat}"] if c in by_case else None
+                                             for c in labels]
+        series_success[label] = [by_case[c]["success_rate"] if c in by_case else None
+                                 for c in labels]
+    report.bars(axes[0], labels, series_rtf, "compute per step / control period (CPU time)")
+    axes[0].axvline(TARGET_RTF, color="k", lw=0.8)
+    report.bars(axes[1], labels, series_success, "success rate", log=False)
+    report.save_figure(fig, path)
+
+
+def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
+    """Play the rows ``keys`` on every task, merge into ``control.json``; the summary."""
+    progress = Progress()
+    record: dict[str, Any] = {"machine": machine_info(), "config": {
+        "quick": quick, "scales": list(SCALES), "controllers": list(keys)}}
+    path = output / "control.json"
+    kept = []
+    if path.exists() and not quick:
+        kept = [r for r in json.loads(path.read_text()).get("records", [])
+                if r["controller"] not in keys]
+    records = []
+    for key in keys:
+        starts = QUICK_STARTS if quick else (SLOW_STARTS if key in SLOW else STARTS)
+        for env_id, objective in REFERENCE_NAMES:
+            records += measure(key, env_id, objective, starts, progress)
+    record["records"] = kept + records
+    record["targets"] = targets(record["records"])
+    finish(record, progress.elapsed)
+    report.write_json(report.json_safe(record), path)
+    plot(record["records"], output / "control.png")
+    columns = ["label", "task", "scale", "starts", "rtf_median", "rtf_p95", "rtf_worst",
+               "success_rate", "ratio"]
+    return report.summary(record, ("numpy", "scipy", "casadi", "mdi-envs"),
+                          {"Controllers": (record["records"], columns)})
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point."""
+    args = arguments(__doc__, argv, ("--controllers", {
+        "nargs": "+", "choices": list(CONTROLLERS), "default": None,
+        "help": "rows to play (default: all; --quick: all but the slow ones)"}))
+    keys = args.controllers or [k for k in CONTROLLERS if not (args.quick and k in SLOW)]
+    args.output.mkdir(parents=True, exist_ok=True)
+    print(run(args.quick, args.output, keys))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
