@@ -3,6 +3,8 @@
 ``lqr_controller(env_id, objective)`` plays ``optimal.lqr.TimeVaryingLQR`` along the reference of
 (env id, objective), in the same env configuration as the MPC below; it costs microseconds per
 step and is registered in ``baselines.evaluation.CONTROLLER_FACTORIES``, so every study plays it.
+``tracking_controller`` plays ``optimal.tracking.TrackingMPC`` (its window NLPs take 10-60 s to
+build, once per row).
 
 ``mpc_controller(env_id, objective)`` plays ``ShrinkingHorizonMPC`` around the reference of (env
 id, objective) in the env configured like the reference's open-loop replay (one env step per
@@ -25,6 +27,9 @@ from optimal.replay import env_options
 
 MPC = "MPC (shrinking horizon)"
 """The label of the MPC rows."""
+
+TRACKING = "MPC (tracking window)"
+"""The label of the tracking MPC rows."""
 
 LQR = "LQR (time-varying)"
 """The label of the LQR rows."""
@@ -73,4 +78,21 @@ def mpc_controller(env_id: str, objective: str) -> Controller | None:
     return Controller(MPC, make_policy, _env_options(reference))
 
 
-__all__ = ["LQR", "MPC", "lqr_controller", "mpc_controller"]
+def tracking_controller(env_id: str, objective: str) -> Controller | None:
+    """The tracking MPC along the reference of (env id, objective); None without one or CasADi."""
+    name = REFERENCE_NAMES.get((env_id, objective))
+    if name is None or importlib.util.find_spec("casadi") is None:
+        return None
+    from optimal.tracking import TrackingMPC
+
+    reference = load_reference(name)
+    controller = TrackingMPC(reference)
+
+    def make_policy(_env: Any) -> TrackingMPC:
+        controller.reset()
+        return controller
+
+    return Controller(TRACKING, make_policy, _env_options(reference))
+
+
+__all__ = ["LQR", "MPC", "TRACKING", "lqr_controller", "mpc_controller", "tracking_controller"]

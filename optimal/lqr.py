@@ -130,6 +130,8 @@ class TimeVaryingLQR:
 
     Attributes:
         gains: (N, m, 2n) K_k. hold_gain: (m, 2n) the gain past the reference.
+        cost_to_go: (N+1, 2n, 2n) P_k. hold_cost_to_go: (2n, 2n) P past the reference.
+        state_weight: (2n, 2n) Q. input_weight: (m, m) R.
         compute_times: CPU time [s] of each control step of this episode.
     """
 
@@ -152,12 +154,13 @@ class TimeVaryingLQR:
         A, B = np.array([a for a, _ in pairs]), np.array([b for _, b in pairs])
         Q = state_weight(reference)
         R = input_weight / self.torque_bound**2 * np.eye(model.NUM_INPUTS)
-        self.gains, _ = riccati(A, B, Q, R, terminal_weight * Q)
+        self.gains, self.cost_to_go = riccati(A, B, Q, R, terminal_weight * Q)
         rest = np.zeros(model.NUM_INPUTS)
         a, b = linearize(stepper, reference.q[-1], np.zeros(model.NUM_DOFS), rest, brakes[-1])
-        hold, _ = riccati(np.repeat(a[None], HOLD_STEPS, 0), np.repeat(b[None], HOLD_STEPS, 0),
-                          Q, R, terminal_weight * Q)
-        self.hold_gain = hold[0]
+        hold, hold_cost = riccati(np.repeat(a[None], HOLD_STEPS, 0),
+                                  np.repeat(b[None], HOLD_STEPS, 0), Q, R, terminal_weight * Q)
+        self.hold_gain, self.hold_cost_to_go = hold[0], hold_cost[0]
+        self.state_weight, self.input_weight = Q, R
         self._goal = np.concatenate([reference.q[-1], np.zeros(model.NUM_DOFS)])
         self.compute_times: list[float] = []
 

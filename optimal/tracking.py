@@ -1,0 +1,240 @@
+"""Receding-horizon tracking MPC: a short window of the reference re-solved at every env step.
+
+At env step k the controller solves, from the measured state, the transcription
+(``optimal.transcription``: the simulator's midpoint step, exact contact and brake laws) over
+the next H (``HORIZON``) intervals with the mode pattern of the reference's intervals k ... k+H-1
+fixed (brake schedule, stick-slip), and the cost
+
+    sum_{j=1}^{H-1} |x_j - x_{k+j}|_Q^2 + sum_{j=0}^{H-1} |tau_j - tau_{k+j}|_R^2
+        + |x_H - x_{k+H}|_{P_{k+H}}^2,
+
+with Q, R and the terminal weight P_{k+H} the time-varying LQR's (``optimal.lqr``: the
+cost-to-go of the linearized problem beyond the window). The torque bounds are constraints, so
+the plan respects the saturation the LQR clips. It applies the first torque and the reference's
+brake command of interval k. Past the reference's end, a brake model's window holds the goal
+at rest with zero torque under the last brake command (the LQR's hold weight as P) from step N
+on; a contact model's windows shrink to the reference's end and the LQR holds the goal after
+it: holding a rest state would stick every contact, whose laws then repeat the rows of u = 0
+(a rank-deficient NLP). For the same reason the contact modes of a reference's last interval,
+which ends at rest, are its neighbour's.
+
+One NLP per distinct window pattern is built in the constructor with the start, the reference
+window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
+dual start) (``Opti.to_function``); a control step is one call, warm-started from the previous
+step's solution shifted by one interval (and its multipliers; after a failed step, the last
+solution shifted as far), or from the reference window on the first step. IPOPT runs from a
+small barrier parameter to a loose tolerance (``SOLVER_OPTIONS``) and at most
+``MAX_ITERATIONS`` iterations; if it fails, the LQR's control is applied (``fallbacks``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from typing import Any
+
+import numpy as np
+
+from mdi_envs._types import FloatArray
+from optimal.continuation import POLISH_RELAXATION
+from optimal.lqr import TimeVaryingLQR
+from optimal.modes import ModePattern
+from optimal.observations import decode_observation
+from optimal.problems import make_problem
+from optimal.references import Reference
+from optimal.transcription import GUESS_IMPULSES, Transcription
+
+HORIZON = {"manipulator_time": 30}
+"""Intervals of the window (one env step each) per reference, ``DEFAULT_HORIZON`` for the others.
+The manipulator's underactuated swing needs the longer window: at 15 intervals its plans
+saturate behind the reference and arrive 1.5x late from 0.1-perturbed starts."""
+
+DEFAULT_HORIZON = 15
+"""The window of references not in ``HORIZON``."""
+
+MAX_ITERATIONS = 50
+"""IPOPT's iteration limit per control step."""
+
+SOLVER_OPTIONS = {"print_level": 0, "sb": "yes", "tol": 1e-4, "acceptable_tol": 1e-3,
+                  "mu_init": 1e-4, "warm_start_init_point": "yes"}
+"""IPOPT's options besides the iteration limit."""
+
+
+@dataclasses.dataclass
+class _Window:
+    """One window pattern's NLP as a function (see the module docstring)."""
+
+    transcription: Transcription
+    solve: Any
+    shapes: list[tuple[int, int]]
+
+
+class TrackingMPC:
+    """The receding-horizon tracking MPC along ``reference`` (see the module docstring).
+
+    Args:
+        reference: the reference tracked; its grid step h must be the env's dt.
+        horizon: intervals of the window (None: ``HORIZON``). max_iterations: see
+            ``MAX_ITERATIONS``.
+
+    Attributes:
+        lqr: the ``TimeVaryingLQR`` whose weights and fallback control it uses.
+        compute_times: CPU time [s] of each control step of this episode.
+        fallbacks: steps of this episode at which IPOPT failed and the LQR's control was applied.
+        iterations: IPOPT's iterations per step of this episode.
+    """
+
+    def __init__(self, reference: Reference, horizon: int | None = None,
+                 max_iterations: int = MAX_ITERATIONS) -> None:
+        self.reference = reference
+        self.horizon = int(horizon or HORIZON.get(reference.name, DEFAULT_HORIZON))
+        self.max_iterations = int(max_iterations)
+        self.lqr = TimeVaryingLQR(reference)
+        self.base = make_problem(reference.name, len(reference.tau))
+        self.has_brake = bool(self.base.model.NUM_BRAKES)
+        self.torque_bound = float(reference.metadata["torque_bound"])
+        steps, n = len(reference.tau), self.base.model.NUM_DOFS
+        extension = self.horizon if self.has_brake else 0
+        rest = np.concatenate([reference.q[-1], np.zeros(n)])
+        self._x = np.vstack([np.hstack([reference.q, reference.u]),
+                             np.repeat(rest[None], extension, 0)])
+        self._tau = np.vstack([reference.tau, np.zeros((extension, len(reference.tau[0])))])
+        engaged, sliding = _reference_modes(reference)
+        if sliding is not None:  # the last interval, at rest: its neighbour's contact modes
+            sliding = np.hstack([sliding[:, :-1], sliding[:, -2:-1]])
+        self._modes = tuple(None if rows is None else
+                            np.hstack([rows, np.repeat(rows[:, -1:], extension, 1)])
+                            for rows in (engaged, sliding))
+        self._brake = (np.vstack([reference.brake_bound,
+                                  np.repeat(reference.brake_bound[-1:], extension, 0)])
+                       if self.has_brake else None)
+        self._terminal = np.concatenate([self.lqr.cost_to_go,
+                                         np.repeat(self.lqr.hold_cost_to_go[None], extension, 0)])
+        self._windows: dict[bytes, _Window] = {}
+        self._keys = [self._window(k) for k in range(steps + (1 if extension else 0))]
+        self._first = self._reference_point()
+        self.compute_times: list[float] = []
+        self.fallbacks: list[int] = []
+        self.iterations: list[int] = []
+        self._previous: tuple[_Window, FloatArray, FloatArray, int] | None = None
+
+    def reset(self) -> None:
+        """A new episode: step counter, records and warm start start again."""
+        self.compute_times, self.fallbacks, self.iterations = [], [], []
+        self._previous = None
+
+    def __call__(self, observation: FloatArray) -> FloatArray:
+        """The env action (default Box space) for an observation of the reference's env."""
+        clock = time.process_time()
+        step = len(self.compute_times)
+        predicted = self._x[min(step, len(self._keys) - 1)]
+        q, u = decode_observation(observation, predicted[:predicted.size // 2], self.has_brake)
+        tau, brake = self.control(step, q, u)
+        action = [tau / self.torque_bound]
+        if self.has_brake:
+            action.append(np.where(brake > 0.0, 1.0, -1.0))
+        self.compute_times.append(time.process_time() - clock)
+        return np.concatenate(action).astype(np.float32)
+
+    def control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""
+        if step >= len(self._keys):  # past the reference: the hold window, or the LQR
+            if not self.has_brake:
+                return self.lqr.control(step, q, u)
+        k = min(step, len(self._keys) - 1)
+        window = self._windows[self._keys[k]]
+        lam_size = window.transcription.opti.lam_g.shape[0]
+        last, x_last, lam_last, solved_at = self._previous or (
+            self._windows[self._keys[0]], self._first, np.zeros(0), 0)
+        x0 = x_last[_shift_indices(last.shapes, window.shapes, step - solved_at)]
+        lam0 = lam_last if lam_last.size == lam_size else np.zeros(lam_size)
+        length = window.shapes[0][1] - 1  # intervals: q has one column per node
+        end = k + length
+        x, lam, tau = window.solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
+                                   self._terminal[end], x0, lam0)
+        stats = window.solve.stats()
+        self.iterations.append(int(stats.get("iter_count", -1)))
+        brake = self._brake[k] if self._brake is not None else np.zeros(0)
+        success = bool(stats.get("success", False))
+        self._previous = (window, np.asarray(x, dtype=float).ravel(),
+                          np.asarray(lam, dtype=float).ravel() if success else np.zeros(0), step)
+        if not success:  # the next step starts from this last iterate, multipliers zero
+            self.fallbacks.append(step)
+            return self.lqr.control(step, q, u)[0], brake
+        tau0 = np.asarray(tau, dtype=float).reshape(-1, length)[:, 0]
+        return np.clip(tau0, -self.torque_bound, self.torque_bound), brake
+
+    def _window(self, k: int) -> bytes:
+        """The key of window k's NLP (its intervals k ... k + H - 1, as far as there are)."""
+        modes = ModePattern(*(None if rows is None else rows[:, k:k + self.horizon]
+                              for rows in self._modes))
+        key = modes.key()
+        if key not in self._windows:
+            self._windows[key] = self._build(modes)
+        return key
+
+    def _build(self, modes: ModePattern) -> _Window:
+        """The window NLP of ``modes`` as a function (see the module docstring)."""
+        import casadi
+
+        big_h, h = modes.num_intervals, self.reference.time_step
+        problem = dataclasses.replace(self.base, num_intervals=big_h, cost="effort",
+                                      final_time=big_h * h, goal_q={}, goal_u={})
+        t = Transcription(problem, modes=modes, parametric_start=True)
+        opti = t.opti
+        n2, m = 2 * self.base.model.NUM_DOFS, self.base.model.NUM_INPUTS
+        x_ref, tau_ref = opti.parameter(n2, big_h + 1), opti.parameter(m, big_h)
+        terminal = opti.parameter(n2, n2)
+        error = casadi.vertcat(t.q, t.u) - x_ref
+        torque = t.tau - tau_ref
+        Q, R = self.lqr.state_weight, self.lqr.input_weight
+        tracking = sum(casadi.bilin(Q, error[:, j], error[:, j]) for j in range(1, big_h))
+        tracking += sum(casadi.bilin(R, torque[:, j], torque[:, j]) for j in range(big_h))
+        tracking += casadi.bilin(terminal, error[:, big_h], error[:, big_h])
+        effort_unit = problem.torque_bound**2 * problem.final_time
+        opti.minimize(opti.f - t.cost / effort_unit + tracking / big_h)
+        opti.solver("ipopt", {"expand": True, "print_time": False, "error_on_fail": False},
+                    {**SOLVER_OPTIONS, "max_iter": self.max_iterations})
+        q0, u0 = t._start
+        opti.set_value(t.rho, 0.0)
+        opti.set_value(t.relaxation, POLISH_RELAXATION)
+        solve = opti.to_function("window", [q0, u0, x_ref, tau_ref, terminal, opti.x, opti.lam_g],
+                                 [opti.x, opti.lam_g, t.tau])
+        return _Window(t, solve, [raw.shape for raw, _ in t._raw.values()])
+
+    def _reference_point(self) -> FloatArray:
+        """The NLP point of the reference's first window (the first step's warm start)."""
+        t = self._windows[self._keys[0]].transcription
+        span = slice(0, self.horizon)
+        impulses = {key: np.asarray(self.reference.arrays[key][span], dtype=float)
+                    for key in GUESS_IMPULSES if key in self.reference.arrays}
+        t.set_guess(self.reference.q[:self.horizon + 1], self.reference.u[:self.horizon + 1],
+                    self.reference.tau[span], self.horizon * self.reference.time_step, impulses)
+        return t.initial_point()
+
+
+def _shift_indices(old: list[tuple[int, int]], new: list[tuple[int, int]],
+                   by: int) -> np.ndarray:
+    """Indices into an NLP's variables (shapes ``old``) that make another's (shapes ``new``).
+
+    Every variable of a ``Transcription`` is a (rows, columns) matrix over the grid's nodes or
+    intervals, stored column-major in declaration order; each new column j takes the old
+    column j + ``by`` (the plan ``by`` intervals on), the last old column where there is none.
+    """
+    indices, offset = [], 0
+    for (rows, columns), (_, new_columns) in zip(old, new, strict=True):
+        block = offset + np.arange(rows * columns).reshape(columns, rows)
+        indices.append(block[np.minimum(np.arange(new_columns) + by, columns - 1)].ravel())
+        offset += rows * columns
+    return np.concatenate(indices)
+
+
+def _reference_modes(reference: Reference) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """(engaged (k, N) or None, sliding (c, N) or None): the reference's mode pattern."""
+    from optimal.mpc import _reference_plan
+
+    modes = _reference_plan(reference).modes
+    return modes.engaged, modes.sliding
+
+
+__all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "SOLVER_OPTIONS", "TrackingMPC"]

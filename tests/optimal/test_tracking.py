@@ -1,0 +1,54 @@
+"""The receding-horizon tracking MPC on the manipulator reference, with a short window."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+casadi = pytest.importorskip("casadi")
+
+from mdi_envs.rollout import rollout  # noqa: E402
+from optimal.references import load_reference  # noqa: E402
+from optimal.replay import env_options  # noqa: E402
+from optimal.tracking import TrackingMPC, _shift_indices  # noqa: E402
+
+WINDOW = 8
+
+
+@pytest.fixture(scope="module")
+def controller() -> TrackingMPC:
+    return TrackingMPC(load_reference("manipulator_time"), horizon=WINDOW)
+
+
+def test_on_the_reference_the_plan_is_the_reference(controller: TrackingMPC) -> None:
+    """No deviation: the window's optimum is the reference's own controls."""
+    reference = controller.reference
+    controller.reset()
+    tau, brake = controller.control(0, reference.q[0], reference.u[0])
+    np.testing.assert_allclose(tau, reference.tau[0], atol=1e-3 * controller.torque_bound)
+    np.testing.assert_array_equal(brake, reference.brake_bound[0])
+    assert controller.fallbacks == []
+
+
+def test_from_a_perturbed_start_it_reaches_the_goal_in_the_optimal_time(
+        controller: TrackingMPC) -> None:
+    reference = controller.reference
+    options = env_options(reference)
+    options.update(reset_noise_scale=0.01, max_episode_steps=2 * len(reference.tau))
+    controller.reset()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        info = rollout(reference.metadata["env_id"], controller, seed=3, **options).last_info
+    assert info["is_success"]
+    assert info["elapsed_time"] <= 1.01 * reference.final_time
+    assert len(controller.compute_times) == len(controller.iterations)
+
+
+def test_the_warm_start_shifts_every_variable_by_whole_intervals() -> None:
+    """Two variables, (2, 3) and (1, 2), column-major: one interval on, the last repeated."""
+    old = [(2, 3), (1, 2)]
+    np.testing.assert_array_equal(_shift_indices(old, old, 1), [2, 3, 4, 5, 4, 5, 7, 7])
+    np.testing.assert_array_equal(_shift_indices(old, [(2, 2), (1, 1)], 1), [2, 3, 4, 5, 7])
+    np.testing.assert_array_equal(_shift_indices(old, old, 0), np.arange(8))
