@@ -35,7 +35,7 @@ LQR = "LQR (time-varying)"
 """The label of the LQR rows."""
 
 
-def _env_options(reference: Reference) -> dict[str, Any]:
+def row_env_options(reference: Reference) -> dict[str, Any]:
     """The reference's env options; time-optimal objectives get twice its steps."""
     options = env_options(reference)
     options.pop("reset_noise_scale")
@@ -58,7 +58,7 @@ def lqr_controller(env_id: str, objective: str) -> Controller | None:
         controller.reset()
         return controller
 
-    return Controller(LQR, make_policy, _env_options(reference))
+    return Controller(LQR, make_policy, row_env_options(reference))
 
 
 def mpc_controller(env_id: str, objective: str) -> Controller | None:
@@ -75,7 +75,7 @@ def mpc_controller(env_id: str, objective: str) -> Controller | None:
         controller.reset()  # a new episode: the plan goes, the built NLPs stay
         return controller
 
-    return Controller(MPC, make_policy, _env_options(reference))
+    return Controller(MPC, make_policy, row_env_options(reference))
 
 
 def tracking_controller(env_id: str, objective: str) -> Controller | None:
@@ -92,7 +92,8 @@ def tracking_controller(env_id: str, objective: str) -> Controller | None:
         controller.reset()
         return controller
 
-    return Controller(TRACKING, make_policy, _env_options(reference))
+    return Controller(TRACKING, make_policy, row_env_options(reference))
 
 
-__all__ = ["LQR", "MPC", "TRACKING", "lqr_controller", "mpc_controller", "tracking_controller"]
+__all__ = ["LQR", "MPC", "TRACKING", "lqr_controller", "mpc_controller", "row_env_options",
+           "tracking_controller"]

@@ -8,15 +8,17 @@ machine do not inflate it; the real-time factor is that time over the control pe
 dt, the reference's h): at most 1 means the controller keeps up with the plant. Reported per row:
 the real-time factor's median, 95th percentile and worst over all steps of all episodes; the
 success rate; the time (time tasks) or effort (effort task) over the reference's, mean over the
-successes. The shrinking-horizon MPC takes seconds per step: it plays ``SLOW_STARTS`` starts
-per scale and is left out of ``--quick``. ``--controllers`` plays some rows and keeps the others
-of an existing ``control.json`` (each record carries its date). Writes ``control.json`` and
-``control.png``.
+successes. The shrinking-horizon MPC takes seconds per step: it plays the first ``SLOW_STEPS``
+steps of ``SLOW_STARTS`` starts per scale (compute only); ``--quick`` plays the LQR only.
+``--controllers`` plays some rows and keeps the others of an existing ``control.json`` (each
+record carries its date). With the tracking MPC, ``memory_growth`` measures the memory over
+``MEMORY_STEPS`` steps without a plan. Writes ``control.json`` and ``control.png``.
 """
 
 from __future__ import annotations
 
 import json
+import resource
 import sys
 import time
 import warnings
@@ -28,7 +30,12 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.evaluation import REFERENCE_NAMES, Controller, reference_effort
-from baselines.model_based import lqr_controller, mpc_controller, tracking_controller
+from baselines.model_based import (
+    lqr_controller,
+    mpc_controller,
+    row_env_options,
+    tracking_controller,
+)
 from benchmarks import report
 from benchmarks.timing import Progress, arguments, finish, machine_info
 from optimal.references import load_reference
@@ -38,7 +45,10 @@ CONTROLLERS: dict[str, Callable[[str, str], Controller | None]] = {
 """Row key -> the ``ControllerFactory`` it plays."""
 
 SLOW = ("shrinking",)
-"""Rows that play ``SLOW_STARTS`` starts and are left out of ``--quick``."""
+"""Rows that play ``SLOW_STARTS`` starts."""
+
+QUICK_ROWS = ("lqr",)
+"""The rows ``--quick`` plays (the MPCs take 10-60 s to build or seconds per step)."""
 
 SCALES = (0.01, 0.1)
 """Start perturbation half-widths [rad, rad/s, m, m/s]."""
@@ -46,12 +56,25 @@ SCALES = (0.01, 0.1)
 STARTS, SLOW_STARTS, QUICK_STARTS = 20, 1, 2
 """Perturbed starts per scale: fast rows, ``SLOW`` rows, every row under ``--quick``."""
 
-TARGET_RTF, TARGET_SUCCESS, TARGET_RATIO = 1.0, 0.95, 1.01
-"""Targets per task and scale: median real-time factor, success rate, cost over the optimum."""
+SLOW_STEPS = 12
+"""Steps a ``SLOW`` row plays of each episode: its compute only (its success and cost from
+perturbed starts are the comparison's and robustness study's, ``baselines/``)."""
+
+MEMORY_STEPS, QUICK_MEMORY_STEPS, MEMORY_WARMUP = 300, 40, 10
+"""Steps without a plan of the memory measurement (``memory_growth``), and the first steps
+before it starts (the first calls' one-time allocations)."""
+
+TARGET_RTF, TARGET_SUCCESS, TARGET_RATIO, TARGET_GROWTH_MB = 1.0, 0.95, 1.01, 100.0
+"""Targets per task and scale: median real-time factor, success rate, cost over the optimum;
+and the memory growth over ``MEMORY_STEPS`` steps without a plan [MB]."""
 
 
-def play(controller: Controller, env_id: str, scale: float, seed: int) -> dict[str, Any]:
-    """One episode from ``reset(seed=seed)``: its end ``info`` and each step's CPU time [s]."""
+def play(controller: Controller, env_id: str, scale: float, seed: int,
+         max_steps: int | None = None) -> dict[str, Any]:
+    """One episode from ``reset(seed=seed)``: its end ``info`` and each step's CPU time [s].
+
+    ``max_steps``: stop after this many steps (the end ``info`` is then None).
+    """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = gym.make(env_id, **{**controller.env_kwargs, "reset_noise_scale": scale})
@@ -63,14 +86,19 @@ def play(controller: Controller, env_id: str, scale: float, seed: int) -> dict[s
         action = policy(observation)
         compute.append(time.process_time() - clock)
         observation, _, terminated, truncated, info = env.step(action)
-        if terminated or truncated:
+        if terminated or truncated or len(compute) == max_steps:
             env.close()
-            return {"info": info, "compute": compute}
+            return {"info": None if len(compute) == max_steps and not (terminated or truncated)
+                    else info, "compute": compute}
 
 
-def measure(key: str, env_id: str, objective: str, starts: int,
-            progress: Progress) -> list[dict[str, Any]]:
-    """One record per scale of the row ``key`` on the task (env id, objective)."""
+def measure(key: str, env_id: str, objective: str, starts: int, progress: Progress,
+            max_steps: int | None = None) -> list[dict[str, Any]]:
+    """One record per scale of the row ``key`` on the task (env id, objective).
+
+    ``max_steps``: play only the first steps of each episode (compute only; success and cost
+    are then None).
+    """
     controller = CONTROLLERS[key](env_id, objective)
     if controller is None:
         return []
@@ -80,22 +108,59 @@ def measure(key: str, env_id: str, objective: str, starts: int,
     for scale in SCALES:
         episodes = []
         for seed in range(starts):
-            episodes.append(play(controller, env_id, scale, seed))
+            episodes.append(play(controller, env_id, scale, seed, max_steps))
+            info = episodes[-1]["info"]
             progress(f"{key} {reference.name} scale {scale} seed {seed}: "
-                     f"{'success' if episodes[-1]['info']['is_success'] else 'failure'}")
+                     f"{'cut' if info is None else 'success' if info['is_success'] else 'failure'}")
         steps = np.concatenate([e["compute"] for e in episodes]) / reference.time_step
-        success = [bool(e["info"]["is_success"]) for e in episodes]
+        played = [e["info"] for e in episodes if e["info"] is not None]
+        success = [bool(info["is_success"]) for info in played]
         cost = "elapsed_time" if objective == "time" else "effort"
-        ratios = [e["info"][cost] / optimum for e, ok in zip(episodes, success, strict=True) if ok]
+        ratios = [info[cost] / optimum for info, ok in zip(played, success, strict=True) if ok]
         records.append({
             "controller": key, "label": controller.label, "task": reference.name,
             "scale": scale, "starts": starts, "control_period_s": reference.time_step,
             "rtf_median": float(np.median(steps)), "rtf_p95": float(np.percentile(steps, 95)),
-            "rtf_worst": float(np.max(steps)), "success_rate": float(np.mean(success)),
+            "rtf_worst": float(np.max(steps)), "steps": int(steps.size),
+            "success_rate": float(np.mean(success)) if success else None,
             "ratio": float(np.mean(ratios)) if ratios else None,
             "ratios": [float(r) for r in ratios], "date": time.strftime("%Y-%m-%d %H:%M UTC",
                                                                            time.gmtime())})
     return records
+
+
+def memory_growth(steps: int, progress: Progress) -> dict[str, Any]:
+    """Peak resident memory growth over ``steps`` control steps in which no plan is found.
+
+    The tracking MPC on the manipulator with IPOPT limited to one iteration, so every step's
+    window solve fails and the LQR's control is applied; episodes from 0.1-perturbed starts
+    are played until ``steps`` steps have been taken after the first episode's first
+    ``MEMORY_WARMUP`` steps (``resource.getrusage``'s peak RSS, before and after).
+    """
+    from optimal.tracking import TrackingMPC
+
+    reference = load_reference("manipulator_time")
+    controller = TrackingMPC(reference, max_iterations=1)
+    options = {**row_env_options(reference), "reset_noise_scale": 0.1}
+    env = gym.make(reference.metadata["env_id"], **options)
+    taken, seed, start = 0, 0, None
+    while taken < steps + MEMORY_WARMUP:
+        controller.reset()
+        observation, _ = env.reset(seed=seed)
+        done = False
+        while not done and taken < steps + MEMORY_WARMUP:
+            observation, _, terminated, truncated, _ = env.step(controller(observation))
+            done = terminated or truncated
+            taken += 1
+            if taken == MEMORY_WARMUP:
+                start = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        failed = len(controller.fallbacks) == len(controller.compute_times)
+        progress(f"memory: episode {seed}, {taken} steps, every step without a plan: {failed}")
+        seed += 1
+    end = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return {"controller": "tracking", "task": reference.name, "steps": steps,
+            "episodes": seed, "peak_rss_start_mb": start / 1024, "peak_rss_end_mb": end / 1024,
+            "growth_mb": (end - start) / 1024}
 
 
 def targets(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -141,32 +206,45 @@ def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
     record: dict[str, Any] = {"machine": machine_info(), "config": {
         "quick": quick, "scales": list(SCALES), "controllers": list(keys)}}
     path = output / "control.json"
-    kept = []
-    if path.exists() and not quick:
-        kept = [r for r in json.loads(path.read_text()).get("records", [])
-                if r["controller"] not in keys]
     records = []
     for key in keys:
         starts = QUICK_STARTS if quick else (SLOW_STARTS if key in SLOW else STARTS)
         for env_id, objective in REFERENCE_NAMES:
-            records += measure(key, env_id, objective, starts, progress)
+            records += measure(key, env_id, objective, starts, progress,
+                               SLOW_STEPS if key in SLOW else None)
+    kept = []  # read at the end: a run of other rows may have written meanwhile
+    if path.exists() and not quick:
+        kept = [r for r in json.loads(path.read_text()).get("records", [])
+                if r["controller"] not in keys]
     record["records"] = kept + records
     record["targets"] = targets(record["records"])
+    if "tracking" in keys:
+        record["memory"] = memory_growth(QUICK_MEMORY_STEPS if quick else MEMORY_STEPS, progress)
+        record["targets"].append(report.target_row(
+            f"peak RSS growth over {record['memory']['steps']} steps without a plan",
+            "≤", TARGET_GROWTH_MB, "MB", record["memory"]["growth_mb"],
+            "tracking MPC, manipulator"))
+    elif path.exists() and not quick:
+        previous = json.loads(path.read_text())
+        record["memory"] = previous.get("memory")
+        record["targets"] += [t for t in previous.get("targets", []) if "RSS" in t["target"]]
     finish(record, progress.elapsed)
     report.write_json(report.json_safe(record), path)
     plot(record["records"], output / "control.png")
     columns = ["label", "task", "scale", "starts", "rtf_median", "rtf_p95", "rtf_worst",
                "success_rate", "ratio"]
     return report.summary(record, ("numpy", "scipy", "casadi", "mdi-envs"),
-                          {"Controllers": (record["records"], columns)})
+                          {"Controllers": (record["records"], columns),
+                           "Memory without a plan": [record["memory"]] if record.get("memory")
+                           else []})
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point."""
     args = arguments(__doc__, argv, ("--controllers", {
         "nargs": "+", "choices": list(CONTROLLERS), "default": None,
-        "help": "rows to play (default: all; --quick: all but the slow ones)"}))
-    keys = args.controllers or [k for k in CONTROLLERS if not (args.quick and k in SLOW)]
+        "help": "rows to play (default: all; --quick: QUICK_ROWS)"}))
+    keys = args.controllers or [k for k in CONTROLLERS if not args.quick or k in QUICK_ROWS]
     args.output.mkdir(parents=True, exist_ok=True)
     print(run(args.quick, args.output, keys))
     return 0

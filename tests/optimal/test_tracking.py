@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import resource
 import warnings
 
 import numpy as np
@@ -52,3 +53,28 @@ def test_the_warm_start_shifts_every_variable_by_whole_intervals() -> None:
     np.testing.assert_array_equal(_shift_indices(old, old, 1), [2, 3, 4, 5, 4, 5, 7, 7])
     np.testing.assert_array_equal(_shift_indices(old, [(2, 2), (1, 1)], 1), [2, 3, 4, 5, 7])
     np.testing.assert_array_equal(_shift_indices(old, old, 0), np.arange(8))
+
+
+def test_steps_without_a_plan_keep_no_memory() -> None:
+    """Without a plan at any step, the peak resident memory stays where the first steps left it.
+
+    IPOPT is held to one iteration, so every step falls back to the LQR; the NLPs are built
+    once, nothing per step.
+    """
+    import gymnasium as gym
+
+    reference = load_reference("manipulator_time")
+    controller = TrackingMPC(reference, horizon=4, max_iterations=1)
+    options = env_options(reference)
+    options.update(reset_noise_scale=0.1, max_episode_steps=2 * len(reference.tau))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make(reference.metadata["env_id"], **options)
+    observation, _ = env.reset(seed=0)
+    for step in range(60):
+        if step == 10:
+            start = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        observation, *_ = env.step(controller(observation))
+    growth_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - start
+    assert controller.fallbacks == list(range(60))
+    assert growth_kb < 10 * 1024  # the unbounded growth kept ~100 MB per such step
