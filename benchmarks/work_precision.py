@@ -21,16 +21,13 @@ from typing import Any
 import numpy as np
 
 from benchmarks import report, timing
-from benchmarks.engine import brake_rows, brake_stop_study
 from benchmarks.engine_mujoco import (
-    MujocoArm,
     MujocoArmRun,
     MujocoBall,
     calibrate_dampratio,
     formula_dampratio,
     import_mujoco,
 )
-from benchmarks.engine_scenes import TIME_STEP
 from benchmarks.report import format_number as _format
 from benchmarks.report import log_lines, plt, save_figure, summary
 from benchmarks.timing import Progress, TimingPlan
@@ -115,7 +112,6 @@ class WorkPrecisionConfig:
     mujoco_ball_time_steps: tuple[float, ...]
     mujoco_arm_time_steps: tuple[float, ...]
     timing: TimingPlan
-    brake_stop: bool
     mujoco_ball_series: tuple[str, ...] = ("formula", "calibrated")
     mujoco_arm_series: tuple[str, ...] = ("default", "stiffest")
     slope_time_steps: tuple[float, ...] = ()
@@ -130,14 +126,14 @@ FULL = WorkPrecisionConfig(
     manipulator_time_steps=(4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 2e-5, 1e-5),
     mujoco_ball_time_steps=(1e-2, 4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 1e-5),
     mujoco_arm_time_steps=(4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 1e-5),
-    timing=TimingPlan(budget_s=0.5, min_rounds=3, max_rounds=15), brake_stop=True,
+    timing=TimingPlan(budget_s=0.5, min_rounds=3, max_rounds=15),
     slope_time_steps=(1e-2, 4e-3, 2e-3, 1e-3, 4e-4, 2e-4, 1e-4, 4e-5, 1e-5),
     diff_drive_time_steps=(1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4))
 QUICK = WorkPrecisionConfig(
     scenes=("ball", "manipulator"), methods=("enumerative",), ball_time_steps=(4e-3, 2e-3, 1e-3),
     ball_drops=8, tolerances=(1e-8,), manipulator_time_steps=(4e-3, 2e-3, 1e-3),
     mujoco_ball_time_steps=(2e-3, 1e-3, 1e-4), mujoco_arm_time_steps=(2e-3, 1e-3),
-    timing=TimingPlan(budget_s=0.0, min_rounds=3, max_rounds=3), brake_stop=False)
+    timing=TimingPlan(budget_s=0.0, min_rounds=3, max_rounds=3))
 
 
 @dataclass
@@ -630,7 +626,7 @@ def observed_order(points: Sequence[dict[str, Any]]) -> float | None:
     return float(np.polyfit(np.log(dts), np.log(errors), 1)[0])
 
 
-def evaluate_targets(points: Sequence[dict[str, Any]], brake: dict[str, Any] | None
+def evaluate_targets(points: Sequence[dict[str, Any]]
                      ) -> tuple[list[dict[str, Any]], dict[str, Any] | None]:
     """The targets against the measurements, and the ball's equal-time comparison."""
     ours = [p for p in points if p["scene"] == "ball" and p["series"] == "mj_enumerative"]
@@ -667,15 +663,6 @@ def evaluate_targets(points: Sequence[dict[str, Any]], brake: dict[str, Any] | N
         targets.append(report.target_row(name, "≥", TARGET_RATIO, "×", bound,
                                          "lower bounds only: " + comparison["summary"]))
         targets[-1]["met"] = True if bound >= TARGET_RATIO else None
-    ours_brake = (brake or {}).get("ours")
-    steps = None if ours_brake is None else ours_brake["steps"]
-    mj_default = (brake or {}).get("mujoco_default", {}).get("steps")
-    mj_stiff = (brake or {}).get("mujoco_stiffest", {}).get("steps")
-    targets.append(report.target_row(
-        "brake stops the relative motion (steps until < 1 % of 1 rad/s, dt = 1e-3 s)",
-        "≤", 1, "steps", steps, "not run (--quick)" if brake is None else
-        f"MuJoCo joint equality, default solref: {mj_default} steps, stiffest solref (2 dt, 1): "
-        f"{mj_stiff} steps"))
     return targets, comparison
 
 
@@ -735,12 +722,9 @@ def run(output: Path, quick: bool, log: Log | None = None,
         points += dd_points
         if dd_reference is not None:
             references["diff_drive"] = dd_reference
-    brake = None
-    if config.brake_stop:
-        brake = _section(ctx, "brake stop", lambda: _brake_stop(ctx), None)
-    targets, comparison = evaluate_targets(points, brake)
+    targets, comparison = evaluate_targets(points)
     record.update({"compile": ctx.compile, "points": points, "references": references,
-                   "mujoco_ball_calibration": calibrations, "brake_stop": brake,
+                   "mujoco_ball_calibration": calibrations,
                    "equal_time": comparison, "targets": targets, "notes": ctx.notes,
                    "failed_sections": ctx.failed_sections})
     timing.finish(record, progress.elapsed)
@@ -751,17 +735,6 @@ def run(output: Path, quick: bool, log: Log | None = None,
     log(f"done in {progress.elapsed:.0f} s; wrote work_precision.json and "
         f"{len(record['plots'])} plots to {output}")
     return record
-
-
-def _brake_stop(ctx: Context) -> dict[str, Any]:
-    """``benchmarks.engine.brake_stop_study`` at its dt = 1e-3 s (ours and MuJoCo's arm)."""
-    st = MoreauJeanStepper(BlockableManipulator, time_step=TIME_STEP)
-    arm = MujocoArm(ctx.mujoco) if ctx.mujoco is not None else None
-    try:
-        return brake_stop_study({"manipulator": st}, arm, ctx.log)  # type: ignore[arg-type]
-    finally:
-        if arm is not None:
-            arm.close()
 
 
 def series_title(series: str) -> str:
@@ -853,7 +826,6 @@ def markdown_report(record: Mapping[str, Any]) -> str:
            for scene, title in SCENE_TITLES.items()},
         "References": [{"scene": k, **v} for k, v in record["references"].items()],
         "MuJoCo ball calibration": record.get("mujoco_ball_calibration"),
-        "Brake stop (dt = 1e-3 s)": brake_rows(record.get("brake_stop")),
     })
 
 

@@ -71,6 +71,7 @@ def short_optimum():  # noqa: ANN201
     return problem, result
 
 
+@pytest.mark.slow  # NLP solves: the short optimum's search and its checks
 def test_fixed_pattern_solve_reproduces_the_continuation_and_is_complementary(
         short_optimum) -> None:  # noqa: ANN001
     problem, result = short_optimum
@@ -86,6 +87,7 @@ def test_fixed_pattern_solve_reproduces_the_continuation_and_is_complementary(
         assert not neighbour.success or neighbour.cost >= best.cost * (1 - 1e-7)
 
 
+@pytest.mark.slow  # NLP solves: the short optimum's search and its checks
 def test_mode_search_recovers_the_optimum_from_a_shifted_pattern(short_optimum) -> None:  # noqa: ANN001
     problem, result = short_optimum
     best = result.local.best
@@ -100,6 +102,7 @@ def test_mode_search_recovers_the_optimum_from_a_shifted_pattern(short_optimum) 
     np.testing.assert_array_equal(recovered.best.modes.engaged, best.modes.engaged)
 
 
+@pytest.mark.slow  # NLP solves: the short optimum's search and its checks
 def test_searched_solution_replays_to_the_goal_and_refines(short_optimum) -> None:  # noqa: ANN001
     problem, result = short_optimum
     best = result.local.best
