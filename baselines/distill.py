@@ -62,13 +62,15 @@ from stable_baselines3.common.torch_layers import FlattenExtractor
 
 from baselines.datasets import TASKS, dataset_id
 from baselines.evaluation import OBJECTIVES, Controller, play
-from baselines.model_based import lqr_controller, mpc_controller
+from baselines.model_based import lqr_controller, mpc_controller, tracking_controller
 from mdi_envs.provenance import git_commit
 
 EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
-    "lqr": lqr_controller, "mpc": mpc_controller,
+    "lqr": lqr_controller, "tracking": tracking_controller, "mpc": mpc_controller,
 }  # fmt: skip
-"""Expert name -> its ``ControllerFactory`` (``baselines.evaluation``)."""
+"""Expert name -> its ``ControllerFactory`` (``baselines.evaluation``): the time-varying LQR
+(microseconds per label), the tracking MPC (``optimal.tracking``), the shrinking-horizon MPC
+(0.1-1 s per label)."""
 
 SCALES = (0.01, 0.1)
 """The range of the training starts' noise half-width [rad, rad/s, m, m/s] (log-uniform)."""
@@ -337,7 +339,7 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
         raise ValueError(f"unknown expert {expert!r}; known: {', '.join(EXPERTS)}")
     controller = EXPERTS[expert](env_id, OBJECTIVES[env_id][0])
     if controller is None:
-        raise ValueError(f"expert {expert!r} is not available here (the MPC needs CasADi)")
+        raise ValueError(f"expert {expert!r} is not available here (the MPCs need CasADi)")
     th.set_num_threads(1)  # tiny networks: more threads only add synchronisation
     th.manual_seed(seed)
     rng = np.random.default_rng(seed)
