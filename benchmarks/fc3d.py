@@ -11,17 +11,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from benchmarks import report  # noqa: E402
-from benchmarks.problems import peer_data_dir  # noqa: E402
-from benchmarks.timing import Progress, arguments, load_average, machine_info  # noqa: E402
-from mdi_envs.solvers import SolverStatus, fc3d_residual, solve_fc3d  # noqa: E402
-from mdi_envs.solvers.siconos_io import read_friction_contact  # noqa: E402
+from benchmarks import report
+from benchmarks.problems import peer_data_dir
+from benchmarks.report import plt
+from benchmarks.timing import Progress, arguments, load_average, machine_info
+from mdi_envs.solvers import SolverStatus, fc3d_residual, solve_fc3d
+from mdi_envs.solvers.siconos_io import read_friction_contact
 
 TOL = 1e-8
 METHODS: dict[str, dict[str, Any]] = {

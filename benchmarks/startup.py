@@ -168,29 +168,20 @@ def table(record: dict[str, Any]) -> str:
 
 def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
           path: Path) -> None:
-    plt = report.plt
-    labels = [env_id.removeprefix("mdi_envs/") for env_id in ids]
-    figure, axis = plt.subplots(figsize=(9, 4.5))
-    width = 0.8 / (len(entries) + 1)
-    for e, entry in enumerate(entries):
-        values = [record["warm"].get(f"{env_id} {entry}", {}).get("median", 0.0)
-                  for env_id in ids]
-        positions = [i + e * width for i in range(len(ids))]
-        axis.bar(positions, values, width, label=f"warm, {entry}")
-    colds = [record["cold"].get(f"{env_id} single", {}).get("median", 0.0) for env_id in ids]
+    """Bars per id (log): the warm start of each entry and the cold start of ``single``."""
+    series = {f"warm, {entry}": [record["warm"].get(f"{i} {entry}", {}).get("median") for i in ids]
+              for entry in entries}
+    colds = [record["cold"].get(f"{i} single", {}).get("median") for i in ids]
     if any(colds):
-        axis.bar([i + len(entries) * width for i in range(len(ids))], colds, width,
-                 label="cold (empty cache), single", hatch="//", color="0.8", edgecolor="0.4")
+        series["cold (empty cache), single"] = colds
+    figure, axis = report.plt.subplots(figsize=(9, 0.25 * len(ids) * len(series) + 1.8))
     acrobot = record["warm"].get("Acrobot-v1 single", {}).get("median")
     if acrobot:
-        axis.axhline(record["target_ratio"] * acrobot, color="k", linestyle="--", linewidth=1,
+        axis.axvline(record["target_ratio"] * acrobot, color="k", linestyle="--", linewidth=1,
                      label=f"{record['target_ratio']:g}× Acrobot-v1 (single, warm)")
-    axis.set_yscale("log")
-    axis.set_xticks([i + 0.4 - width / 2 for i in range(len(ids))], labels, rotation=15)
-    axis.set_ylabel("interpreter start → first step returned [s]")
-    axis.set_title("Start-up time, fresh processes"
-                   + (" (quick: warm, one run)" if record["quick"] else ""))
-    axis.legend(fontsize=8)
+    report.bars(axis, [i.removeprefix("mdi_envs/") for i in ids], series,
+                "fresh interpreter start → first step returned [s]"
+                + (" (quick: warm, one run)" if record["quick"] else ""))
     report.save_figure(figure, path, dpi=120)
 
 

@@ -14,8 +14,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from benchmarks import report
 from benchmarks.timing import Progress, arguments, machine_info
 
@@ -96,18 +94,12 @@ def markdown(results: Sequence[dict[str, Any]]) -> str:
 def plot(record: dict[str, Any], path: Path) -> None:
     """Bars: training and rollout steps per second per vector env."""
     results = record["results"]
-    positions = np.arange(len(results))
-    fig, ax = report.plt.subplots(figsize=(7, 4))
-    ax.bar(positions - 0.2, [r["train_steps_per_s"] for r in results], 0.4, color="C0",
-           label="training (rollouts + updates)")  # fmt: skip
-    ax.bar(positions + 0.2, [r["rollout_steps_per_s"] for r in results], 0.4, color="C1",
-           label="rollout collection only")  # fmt: skip
-    ax.set_xticks(positions, [r["backend"] for r in results])
-    ax.set_ylabel("environment steps / s")
-    ax.set_title(f"PPO on {record['env_id'].split('/')[-1]}, {record['num_envs']} copies, "
-                 f"{record['results'][0]['timesteps']:,} steps each")  # fmt: skip
-    ax.legend()
-    ax.grid(alpha=0.3, axis="y")
+    fig, ax = report.plt.subplots(figsize=(8, 3.4))
+    report.bars(ax, [r["backend"] for r in results], {
+        "training (rollouts + updates)": [r["train_steps_per_s"] for r in results],
+        "rollout collection only": [r["rollout_steps_per_s"] for r in results]},
+        f"environment steps / s: PPO on {record['env_id'].split('/')[-1]}, "
+        f"{record['num_envs']} copies, {results[0]['timesteps']:,} steps each", log=False)
     report.save_figure(fig, path, dpi=110)
 
 
