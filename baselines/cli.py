@@ -102,8 +102,9 @@ def _study_arguments(parser: argparse.ArgumentParser, scales: list[float],
                         help="folder of the trained policies (default: baselines/trained; e.g. "
                         "the output of mdi-envs sweep)")
     parser.add_argument("--mpc", action="store_true",
-                        help="also play the shrinking-horizon MPC around the reference "
-                        "(optimal.mpc; needs CasADi; 0.1-1 s of compute per env step)")
+                        help="also play the MPC rows around the reference: the shrinking-horizon "
+                        "MPC (optimal.mpc; 0.1-1 s of compute per env step) and the tracking MPC "
+                        "(optimal.tracking; milliseconds); both need CasADi")
     parser.add_argument("--controllers", nargs="+", default=None, metavar="LABEL",
                         help="play only these rows (labels as in the table, e.g. PPO HybridPPO "
                         "'MPC (shrinking horizon)') and merge them into the study already in "
@@ -202,13 +203,14 @@ def _studies(args: argparse.Namespace, prefix: str, nominal: bool,
     for env_id, objective in jobs:
         extra = []
         if args.mpc:
-            from baselines.model_based import mpc_controller
+            from baselines.model_based import mpc_controller, tracking_controller
 
-            controller = mpc_controller(env_id, objective)
-            if controller is None:
-                raise SystemExit(f"{prefix}: --mpc needs CasADi (pip install "
-                                 "'mdi-envs[optimal]')")
-            extra.append(controller)
+            for factory in (mpc_controller, tracking_controller):
+                controller = factory(env_id, objective)
+                if controller is None:
+                    raise SystemExit(f"{prefix}: --mpc needs CasADi (pip install "
+                                     "'mdi-envs[optimal]')")
+                extra.append(controller)
         try:
             study = evaluate(env_id, objective, conditions(env_id), args.seeds,
                              trained_dir=trained_dir, extra_controllers=extra,

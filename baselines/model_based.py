@@ -4,7 +4,7 @@
 (env id, objective), in the same env configuration as the MPC below; it costs microseconds per
 step and is registered in ``baselines.evaluation.CONTROLLER_FACTORIES``, so every study plays it.
 ``tracking_controller`` plays ``optimal.tracking.TrackingMPC`` (its window NLPs take 10-60 s to
-build, once per row).
+build, once per row, at its first episode); ``--mpc`` adds it with the shrinking-horizon MPC.
 
 ``mpc_controller(env_id, objective)`` plays ``ShrinkingHorizonMPC`` around the reference of (env
 id, objective) in the env configured like the reference's open-loop replay (one env step per
@@ -86,11 +86,13 @@ def tracking_controller(env_id: str, objective: str) -> Controller | None:
     from optimal.tracking import TrackingMPC
 
     reference = load_reference(name)
-    controller = TrackingMPC(reference)
+    built: list[TrackingMPC] = []  # built on the first episode: a row not played costs nothing
 
     def make_policy(_env: Any) -> TrackingMPC:
-        controller.reset()
-        return controller
+        if not built:
+            built.append(TrackingMPC(reference))
+        built[0].reset()
+        return built[0]
 
     return Controller(TRACKING, make_policy, row_env_options(reference))
 

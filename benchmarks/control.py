@@ -1,7 +1,7 @@
 """Model-based controllers in real time (``mdi-envs bench control``): compute, success, cost.
 
-Each controller row of ``baselines.model_based`` plays every optimal reference's task
-(``baselines.evaluation.REFERENCE_NAMES``) from perturbed starts (``reset(seed=s)`` at each
+Each controller row of ``baselines.model_based`` plays every optimal reference's task (``TASKS``,
+in the env id of its metadata) from perturbed starts (``reset(seed=s)`` at each
 ``SCALES`` half-width) in the env configured like the comparison. The compute of each control
 step is CPU time (``time.process_time`` around the policy call), so other processes on the
 machine do not inflate it; the real-time factor is that time over the control period (the env's
@@ -43,6 +43,9 @@ from optimal.references import load_reference
 CONTROLLERS: dict[str, Callable[[str, str], Controller | None]] = {
     "lqr": lqr_controller, "tracking": tracking_controller, "shrinking": mpc_controller}
 """Row key -> the ``ControllerFactory`` it plays."""
+
+TASKS = tuple(dict.fromkeys(REFERENCE_NAMES.values()))
+"""The references, each played in the env it was computed for (its metadata's env id)."""
 
 SLOW = ("shrinking",)
 """Rows that play ``SLOW_STARTS`` starts."""
@@ -209,8 +212,9 @@ def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
     records = []
     for key in keys:
         starts = QUICK_STARTS if quick else (SLOW_STARTS if key in SLOW else STARTS)
-        for env_id, objective in REFERENCE_NAMES:
-            records += measure(key, env_id, objective, starts, progress,
+        for name in TASKS:
+            meta = load_reference(name).metadata
+            records += measure(key, meta["env_id"], meta["cost_kind"], starts, progress,
                                SLOW_STEPS if key in SLOW else None)
     kept = []  # read at the end: a run of other rows may have written meanwhile
     if path.exists() and not quick:
