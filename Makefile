@@ -5,7 +5,8 @@
 # way when they install the `rl` extra. Each first compiles every env kernel into the disk cache
 # (`mdi-envs compile all`), so that the processes after it start warm. The tests run on every core
 # (pytest-xdist); --dist loadfile keeps each file on one worker, so that a module's fixture (the
-# kernel-cache tests compile into an empty cache) runs once.
+# kernel-cache tests compile into an empty cache) runs once, and tests/conftest.py hands out the
+# files with the most slow tests first.
 
 PYTHON ?= python3
 VENV ?= .venv
