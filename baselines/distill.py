@@ -25,7 +25,8 @@ evaluation's seeds 0, 1, ....
 The learner is an SB3 policy: ``PPO``'s ``ActorCriticPolicy`` on the robots' Box actions,
 ``HybridPPO``'s policy on the manipulator with ``action_mode="hybrid"``, so the brake is a
 discrete choice (the expert's Box action ``[torque, brake]`` becomes the choice
-``brake > 0`` with the same torque: ``expert_label``). The loss is the negative log-likelihood of
+``brake > 0`` with the same torque: ``expert_label``), its inputs standardized by the mean and
+deviation of round 0's data (``Standardized``). The loss is the negative log-likelihood of
 the expert's actions (``policy.evaluate_actions``), minimised by the policy's own optimizer. The
 model is saved with SB3's ``save`` as ``STEM.zip`` beside a ``STEM.json`` ``TrainingRecord``
 (algo ``"DAgger"``) whose ``distillation`` entry (``Distillation``) holds the expert and its label
