@@ -10,7 +10,7 @@ from benchmarks.report import markdown_table
 
 SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
            ("precision", "work_precision.json"), ("stress", "stress.json"),
-           ("startup", "startup.json"))  # fmt: skip
+           ("startup", "startup.json"), ("control", "control.json"))  # fmt: skip
 """(benchmark name, result file) whose targets enter the table, in this order."""
 
 
