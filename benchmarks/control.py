@@ -37,7 +37,7 @@ from baselines.model_based import (
     tracking_controller,
 )
 from benchmarks import report
-from benchmarks.timing import Progress, arguments, finish, machine_info
+from benchmarks.timing import VERSIONED_PACKAGES, Progress, arguments, finish, machine_info
 from optimal.references import load_reference
 
 CONTROLLERS: dict[str, Callable[[str, str], Controller | None]] = {
@@ -206,7 +206,7 @@ def plot(records: Sequence[dict[str, Any]], path: Path) -> None:
 def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
     """Play the rows ``keys`` on every task, merge into ``control.json``; the summary."""
     progress = Progress()
-    record: dict[str, Any] = {"machine": machine_info(), "config": {
+    record: dict[str, Any] = {"machine": machine_info((*VERSIONED_PACKAGES, "casadi")), "config": {
         "quick": quick, "scales": list(SCALES), "controllers": list(keys)}}
     path = output / "control.json"
     records = []
