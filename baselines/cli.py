@@ -257,8 +257,9 @@ def run_compare(args: argparse.Namespace) -> int:
                                condition.label)  # fmt: skip
         (args.output / f"compare_{study.name}.md").write_text(tables([study]))
     everything = [read_study(path) for path in sorted(args.output.glob("compare_*.json"))]
-    (args.output / "compare.md").write_text(tables(everything))
-    print(tables(everything))
+    text = tables(everything)
+    (args.output / "compare.md").write_text(text)
+    print(text)
     return 0
 
 
