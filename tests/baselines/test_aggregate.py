@@ -9,6 +9,7 @@ from baselines.aggregate import (
     improvement_probability,
     iqm_interval,
     optimality_score,
+    pairwise_win_rate,
     performance_profiles,
     sampled_curve,
     success_curve,
@@ -83,6 +84,17 @@ def test_improvement_probability_is_the_pairwise_win_rate() -> None:
     assert point == 1.0 and ci is None  # one run each: no interval
     _, ci = improvement_probability([0.1, 0.5, 0.9], [0.2, 0.6], reps=500)
     assert ci is not None and 0.0 <= ci[0] < ci[1] <= 1.0
+
+
+def test_the_win_rate_is_rliables_probability_of_improvement() -> None:
+    from rliable import metrics
+
+    rng = np.random.default_rng(3)
+    for n, m in ((5, 3), (10, 10), (1, 4)):
+        x = rng.integers(0, 4, (n, 1)) / 4  # ties included
+        y = rng.integers(0, 4, (m, 1)) / 4
+        assert pairwise_win_rate(x, y) == pytest.approx(
+            metrics.probability_of_improvement(x, y), abs=1e-12)  # fmt: skip
 
 
 def test_optimality_score_is_zero_without_success() -> None:
