@@ -234,14 +234,7 @@ def run_compare(args: argparse.Namespace) -> int:
     from baselines.evaluation import TRAINED_DIR
     from baselines.plots import plot_brake_use, plot_comparison, plot_seeds
     from baselines.records import Condition, read_study
-    from baselines.tables import brake_use_table, comparison_table, improvement_table
-
-    def tables(studies: list[Study]) -> str:
-        sections = [comparison_table(studies)]
-        for title, text in (("Probability of improvement", improvement_table(
-                studies, args.bootstrap_reps)), ("Brake use", brake_use_table(studies))):
-            sections += [title, text] if text else []
-        return "\n\n".join(sections) + "\n"
+    from baselines.tables import brake_use_table, comparison_report
 
     studies = _studies(args, "compare", True, lambda _: [Condition(s) for s in args.scales])
     trained_dir = args.trained or TRAINED_DIR
@@ -255,9 +248,10 @@ def run_compare(args: argparse.Namespace) -> int:
             if brake_use_table([study]):
                 plot_brake_use(study, args.output / f"brake_{study.name}{tail}.png",
                                condition.label)  # fmt: skip
-        (args.output / f"compare_{study.name}.md").write_text(tables([study]))
+        (args.output / f"compare_{study.name}.md").write_text(
+            comparison_report([study], args.bootstrap_reps))
     everything = [read_study(path) for path in sorted(args.output.glob("compare_*.json"))]
-    text = tables(everything)
+    text = comparison_report(everything, args.bootstrap_reps)
     (args.output / "compare.md").write_text(text)
     print(text)
     return 0

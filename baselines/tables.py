@@ -188,6 +188,19 @@ def improvement_table(studies: Sequence[Study], reps: int | None = None) -> str:
     return pd.DataFrame(records, columns=columns).to_markdown(index=False) if records else ""
 
 
+def comparison_report(studies: Sequence[Study], reps: int | None = None) -> str:
+    """The comparison's Markdown file (``compare.md``): the tables of ``studies``.
+
+    ``comparison_table``, then the probability of improvement and the brake use where there are
+    any (``reps``: the bootstrap replications of ``improvement_table``).
+    """
+    sections = [comparison_table(studies)]
+    for title, text in (("Probability of improvement", improvement_table(studies, reps)),
+                        ("Brake use", brake_use_table(studies))):
+        sections += [title, text] if text else []
+    return "\n\n".join(sections) + "\n"
+
+
 def robustness_table(studies: Sequence[Study]) -> str:
     """Per study a title line and a table: success (ratio over the successes) per condition.
 
@@ -218,5 +231,5 @@ def robustness_table(studies: Sequence[Study]) -> str:
     return "\n\n".join(parts)
 
 
-__all__ = ["brake_use_table", "budget_text", "comparison_table", "engaged_intervals",
-           "improvement_table", "interval_text", "robustness_table"]
+__all__ = ["brake_use_table", "budget_text", "comparison_report", "comparison_table",
+           "engaged_intervals", "improvement_table", "interval_text", "robustness_table"]

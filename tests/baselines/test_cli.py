@@ -15,7 +15,7 @@ from baselines.evaluation import TRAINED_DIR
 from baselines.heuristics import FOLLOWER
 from baselines.model_based import LQR
 from baselines.records import OPTIMAL, read_study, write_study
-from baselines.tables import comparison_table, interval_text, robustness_table
+from baselines.tables import comparison_report, interval_text, robustness_table
 
 ROBOT = "mdi_envs/DiffDriveRobot-v0"
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
@@ -116,11 +116,10 @@ def test_robustness_writes_json_plot_and_table(tmp_path: Path) -> None:
 def test_the_shipped_tables_are_made_from_the_shipped_studies() -> None:
     comparisons = [read_study(p) for p in sorted((RESULTS / "comparison").glob("compare_*.json"))]
     assert len(comparisons) == 3
-    assert (RESULTS / "comparison" / "compare.md").read_text().strip() == comparison_table(
-        comparisons)
+    assert (RESULTS / "comparison" / "compare.md").read_text() == comparison_report(comparisons)
     for study in comparisons:
         table = (RESULTS / "comparison" / f"compare_{study.name}.md").read_text()
-        assert table.strip() == comparison_table([study])
+        assert table == comparison_report([study])
     studies = [read_study(p) for p in sorted((RESULTS / "robustness").glob("robustness_*.json"))]
     assert (RESULTS / "robustness" / "robustness.md").read_text().strip() == robustness_table(
         studies)
