@@ -1,4 +1,8 @@
-"""The shrinking-horizon MPC on a short manipulator problem (N = 40, h ~ 0.11 s)."""
+"""The shrinking-horizon MPC on a short manipulator problem (N = 40, h ~ 0.11 s).
+
+The tests on the solved reference re-plan with IPOPT at every step: marked slow (`make test`
+runs them, the `not slow` inner loop does not).
+"""
 
 from __future__ import annotations
 
@@ -49,6 +53,7 @@ def _play(reference: Reference, noise: float, seed: int) -> tuple[dict, Shrinkin
     return result.last_info, controller
 
 
+@pytest.mark.slow
 def test_mpc_from_the_nominal_start_follows_the_reference(short_reference) -> None:  # noqa: ANN001
     info, controller = _play(short_reference, 0.0, 0)
     assert info["is_success"]
@@ -59,6 +64,7 @@ def test_mpc_from_the_nominal_start_follows_the_reference(short_reference) -> No
     assert first.cost == pytest.approx(short_reference.final_time, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_mpc_reaches_the_goal_from_a_perturbed_start(short_reference) -> None:  # noqa: ANN001
     info, controller = _play(short_reference, 0.01, 1)
     assert info["is_success"]
@@ -66,6 +72,7 @@ def test_mpc_reaches_the_goal_from_a_perturbed_start(short_reference) -> None:  
     assert all(step.compute_time > 0.0 for step in controller.steps)
 
 
+@pytest.mark.slow
 def test_a_second_episode_reuses_the_built_nlps(short_reference) -> None:  # noqa: ANN001
     options = env_options(short_reference)
     options.update(reset_noise_scale=0.01, max_episode_steps=2 * SHORT_N)
@@ -118,6 +125,7 @@ def test_the_neighbour_fallback_moves_only_imminent_modes() -> None:
         assert (pattern.key() in kept_keys) == (changed.min() < NEIGHBOUR_WINDOW)
 
 
+@pytest.mark.slow
 def test_every_time_plan_is_on_the_env_grid(short_reference) -> None:  # noqa: ANN001
     """t_f = N h: each plan arrives at the end of an env step, and shrinks by one step."""
     info, controller = _play(short_reference, 0.01, 1)
@@ -129,6 +137,7 @@ def test_every_time_plan_is_on_the_env_grid(short_reference) -> None:  # noqa: A
         range(SHORT_N, SHORT_N - len(controller.steps), -1))
 
 
+@pytest.mark.slow
 def test_a_start_needing_more_steps_than_left_gets_them(short_reference) -> None:  # noqa: ANN001
     """From the reference's start with two steps fewer left than it needs: two steps later."""
     controller = ShrinkingHorizonMPC(short_reference)
@@ -139,6 +148,7 @@ def test_a_start_needing_more_steps_than_left_gets_them(short_reference) -> None
     assert step.cost == pytest.approx(short_reference.final_time, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_a_free_grid_plan_slightly_slower_than_h_still_shrinks(short_reference) -> None:  # noqa: ANN001
     """The rest keeps N - 1 intervals within ``REGRID_TOLERANCE`` of h; re-grids beyond."""
     controller = ShrinkingHorizonMPC(short_reference, grid="free")
@@ -159,6 +169,7 @@ def test_a_free_grid_plan_slightly_slower_than_h_still_shrinks(short_reference) 
     assert controller._horizon_after_step(plan(1, h)) == 1  # held at min_horizon
 
 
+@pytest.mark.slow
 def test_the_free_grid_mpc_reaches_the_goal(short_reference) -> None:  # noqa: ANN001
     options = env_options(short_reference)
     options.update(reset_noise_scale=0.01, max_episode_steps=2 * SHORT_N)
@@ -168,6 +179,7 @@ def test_the_free_grid_mpc_reaches_the_goal(short_reference) -> None:  # noqa: A
     assert any(step.horizon != SHORT_N - step.step for step in controller.steps)  # re-gridded
 
 
+@pytest.mark.slow
 def test_the_grid_is_chosen_per_reference_and_checked(short_reference) -> None:  # noqa: ANN001
     assert ShrinkingHorizonMPC(short_reference).grid == GRID_OF_REFERENCE["manipulator_time"]
     with pytest.raises(ValueError, match="grid must be one of"):
