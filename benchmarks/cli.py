@@ -46,7 +46,7 @@ def add_bench_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument("names", nargs="*", metavar="NAME",
                         help=f"benchmarks to run (default: all of {', '.join(BENCHMARKS)})")
     parser.add_argument("--quick", action="store_true",
-                        help="small grids and budgets (about 2-3 min for all; used by make test)")
+                        help="small grids and budgets (about 1-2 min for all; used by make test)")
     parser.add_argument("--skip", nargs="+", default=[], metavar="NAME",
                         help="benchmarks to leave out (make test: stress, which pytest runs)")
     parser.add_argument("--output", type=Path, default=None, help="results folder")

@@ -27,6 +27,8 @@ REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
 """Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
 row, ``startup_probe.FLOOR``) the floor of any numba env: one trivial cached kernel's load."""
 ENTRIES = ("single", "vector", "subproc")
+QUICK_IDS = ("mdi_envs/BlockableManipulator-v1", "Acrobot-v1")
+"""The ids ``--quick`` probes (warm, once, gym.make and gym.make_vec), besides the floor."""
 TARGET_RATIO = 2.0  # Warm start-up target: within this factor of Acrobot-v1's, entry by entry.
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -88,7 +90,7 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
     record: dict[str, Any] = {"machine": machine_info(), "quick": quick,
                               "python_path": str(python_path) if python_path else None,
                               "target_ratio": TARGET_RATIO}
-    ids = list(ENV_IDS) + list(REFERENCES) + [FLOOR]
+    ids = [*(QUICK_IDS if quick else (*ENV_IDS, *REFERENCES)), FLOOR]
     entries = ENTRIES[:2] if quick else ENTRIES
     with tempfile.TemporaryDirectory(prefix="mdi-envs-cache-") as scratch:
         cache = None if quick else Path(scratch) / "warm"
