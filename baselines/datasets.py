@@ -2,13 +2,13 @@
 
 One dataset per task (a v1 env id) and expert: the optimal reference played open loop from the
 nominal start (``"optimal"``, one episode: it is open loop), or a model-based controller around
-that reference (``"lqr"``: ``optimal.lqr.TimeVaryingLQR``; ``"mpc"``: the shrinking-horizon MPC)
-from ``num_episodes`` starts drawn with ``reset(seed=first_seed + k)`` at the start noise
-``scale``. Each expert plays in its own env configuration (``baselines.model_based``: one env step
-per transcription interval of the reference), which the dataset records as its env spec, so
-``dataset.recover_environment()`` rebuilds exactly the env the data came from. Episodes end at the
-goal (``terminations``) or at the step limit (``truncations``); observations, actions and rewards
-are the env's own.
+that reference (``baselines.model_based.EXPERTS``: ``"lqr"``, the time-varying LQR;
+``"tracking"``, the tracking MPC; ``"mpc"``, the shrinking-horizon MPC) from ``num_episodes``
+starts drawn with ``reset(seed=first_seed + k)`` at the start noise ``scale``. Each expert plays
+in its own env configuration (one env step per transcription interval of the reference), which
+the dataset records as its env spec, so ``dataset.recover_environment()`` rebuilds exactly the
+env the data came from. Episodes end at the goal (``terminations``) or at the step limit
+(``truncations``); observations, actions and rewards are the env's own.
 
 Dataset ids: ``mdi_envs/<Task>/<expert>-v0``, e.g. ``mdi_envs/BlockableManipulator/lqr-v0``. They
 are written under ``MINARI_DATASETS_PATH`` (Minari's default ``~/.minari/datasets``; ``--root``
@@ -35,17 +35,16 @@ from baselines.evaluation import (
     Controller,
     optimal_controller,
 )
-from baselines.model_based import lqr_controller, mpc_controller
+from baselines.model_based import EXPERTS
 from mdi_envs.provenance import git_commit
 
 TASKS = (MANIPULATOR_V1, DIFF_DRIVE_V1, DIFF_DRIVE_EFFORT_V1)
 """The v1 env ids a dataset can be built for (one objective each)."""
 
-EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
-    "optimal": optimal_controller, "lqr": lqr_controller, "mpc": mpc_controller,
+DATASET_EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
+    "optimal": optimal_controller, **EXPERTS,
 }  # fmt: skip
-"""Expert name -> its ``ControllerFactory`` (``baselines.evaluation``)."""
-
+"""The reference open loop and the feedback experts (``baselines.model_based.EXPERTS``)."""
 
 def dataset_id(env_id: str, expert: str, version: int = 0) -> str:
     """``mdi_envs/<Task>/<expert>-v<version>``, e.g. ``mdi_envs/DiffDriveRobot/lqr-v0``."""
@@ -59,7 +58,8 @@ def build_dataset(env_id: str, expert: str = "lqr", num_episodes: int = 100, sca
 
     Args:
         env_id: one of ``TASKS``.
-        expert: one of ``EXPERTS``; ``"optimal"`` plays one episode from the nominal start.
+        expert: one of ``DATASET_EXPERTS``; ``"optimal"`` plays one episode from
+            the nominal start.
         num_episodes: episodes from perturbed starts (``reset(seed=first_seed + k)``).
         scale: the start noise half-width ``reset_noise_scale`` [rad, rad/s, m, m/s].
         first_seed: the first reset seed.
@@ -67,19 +67,19 @@ def build_dataset(env_id: str, expert: str = "lqr", num_episodes: int = 100, sca
 
     Raises:
         ValueError: an unknown task or expert, no episodes, or an expert that is not available
-            (the MPC needs CasADi).
+            (the MPCs need CasADi).
     """
     import minari
 
     if env_id not in TASKS:
         raise ValueError(f"no dataset task {env_id!r}; known: {', '.join(TASKS)}")
-    if expert not in EXPERTS:
-        raise ValueError(f"unknown expert {expert!r}; known: {', '.join(EXPERTS)}")
+    if expert not in DATASET_EXPERTS:
+        raise ValueError(f"unknown expert {expert!r}; known: {', '.join(DATASET_EXPERTS)}")
     if num_episodes < 1:
         raise ValueError(f"num_episodes must be >= 1, got {num_episodes}")
-    controller = EXPERTS[expert](env_id, OBJECTIVES[env_id][0])
+    controller = DATASET_EXPERTS[expert](env_id, OBJECTIVES[env_id][0])
     if controller is None:
-        raise ValueError(f"expert {expert!r} is not available here (the MPC needs CasADi)")
+        raise ValueError(f"expert {expert!r} is not available here (the MPCs need CasADi)")
     if expert == "optimal":
         num_episodes, scale = 1, 0.0
     kwargs = {**controller.env_kwargs, "reset_noise_scale": scale}
@@ -108,7 +108,8 @@ def add_dataset_parser(subparsers: Any) -> argparse.ArgumentParser:
         "dataset", help="write an expert's trajectories as a Minari dataset",
         description=__doc__.split("\n\n")[1].replace("\n", " "))  # fmt: skip
     parser.add_argument("env_id", choices=TASKS, help="the task")
-    parser.add_argument("--expert", choices=list(EXPERTS), default="lqr", help="default: lqr")
+    parser.add_argument("--expert", choices=list(DATASET_EXPERTS), default="lqr",
+                        help="default: lqr")
     parser.add_argument("--episodes", type=int, default=100, help="perturbed starts")
     parser.add_argument("--scale", type=float, default=0.1, help="start noise half-width")
     parser.add_argument("--first-seed", type=int, default=0, help="the first reset seed")
@@ -132,4 +133,4 @@ def run_dataset(args: argparse.Namespace) -> int:
     return 0
 
 
-__all__ = ["EXPERTS", "TASKS", "add_dataset_parser", "build_dataset", "dataset_id"]
+__all__ = ["DATASET_EXPERTS", "TASKS", "add_dataset_parser", "build_dataset", "dataset_id"]

@@ -63,15 +63,8 @@ from stable_baselines3.common.torch_layers import FlattenExtractor
 
 from baselines.datasets import TASKS, dataset_id
 from baselines.evaluation import OBJECTIVES, Controller, play
-from baselines.model_based import lqr_controller, mpc_controller, tracking_controller
+from baselines.model_based import EXPERTS
 from mdi_envs.provenance import git_commit
-
-EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
-    "lqr": lqr_controller, "tracking": tracking_controller, "mpc": mpc_controller,
-}  # fmt: skip
-"""Expert name -> its ``ControllerFactory`` (``baselines.evaluation``): the time-varying LQR
-(microseconds per label), the tracking MPC (``optimal.tracking``), the shrinking-horizon MPC
-(0.1-1 s per label)."""
 
 SCALES = (0.01, 0.1)
 """The range of the training starts' noise half-width [rad, rad/s, m, m/s] (log-uniform)."""
@@ -530,7 +523,7 @@ def run_distill(args: argparse.Namespace) -> int:
 
 
 __all__ = [
-    "ALGO", "DEFAULT_OUTPUT", "EXPERTS", "FIRST_TRAINING_SEED", "SCALES", "DAgger",
+    "ALGO", "DEFAULT_OUTPUT", "FIRST_TRAINING_SEED", "SCALES", "DAgger",
     "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill",
     "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs", "learner_policy",
     "make_learner", "native_action", "perturbed_starts", "play_labelled", "write_labels",

@@ -19,6 +19,7 @@ CasADi (the ``optimal`` extra); without it the row is left out.
 from __future__ import annotations
 
 import importlib.util
+from collections.abc import Callable
 from typing import Any
 
 from baselines.evaluation import REFERENCE_NAMES, Controller
@@ -97,5 +98,13 @@ def tracking_controller(env_id: str, objective: str) -> Controller | None:
     return Controller(TRACKING, make_policy, row_env_options(reference))
 
 
-__all__ = ["LQR", "MPC", "TRACKING", "lqr_controller", "mpc_controller", "row_env_options",
-           "tracking_controller"]
+EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
+    "lqr": lqr_controller, "tracking": tracking_controller, "mpc": mpc_controller,
+}  # fmt: skip
+"""Feedback expert name -> its ``ControllerFactory`` (``baselines.evaluation``), the experts of
+the distillation and the datasets: the time-varying LQR (microseconds per step), the tracking
+MPC (milliseconds), the shrinking-horizon MPC (0.1-1 s)."""
+
+
+__all__ = ["EXPERTS", "LQR", "MPC", "TRACKING", "lqr_controller", "mpc_controller",
+           "row_env_options", "tracking_controller"]
