@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("stable_baselines3", reason="needs the rl extra")
+import torch  # noqa: E402
 
 from baselines.distill import (  # noqa: E402
     DAggerSettings,
@@ -91,8 +92,10 @@ def test_the_distilled_manipulator_loads_and_plays_as_a_trained_row(tmp_path: Pa
     assert config["algo"] == "DAgger" and config["env_kwargs"]["action_mode"] == "hybrid"
     assert config["distillation"]["expert"] == "lqr"
     assert config["distillation"]["expert_calls"] == config["num_timesteps"] > 0
+    torch.set_num_threads(2)
     controller = load_policy(path.with_suffix(".json"))
     assert controller.label == "DAgger" and controller.training is not None
+    assert torch.get_num_threads() == 1  # one observation per call: no thread synchronisation
     episode = play(MANIPULATOR_V1, controller.make_policy, 0, **controller.env_kwargs)
     assert episode.num_steps > 0 and episode.brake_use is not None
     brake, torque = controller.make_policy(None)(np.zeros(7, np.float32))  # type: ignore[arg-type]
