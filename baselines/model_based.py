@@ -47,55 +47,46 @@ def row_env_options(reference: Reference) -> dict[str, Any]:
 
 def lqr_controller(env_id: str, objective: str) -> Controller | None:
     """The LQR along the reference of (env id, objective); None without a reference."""
-    name = REFERENCE_NAMES.get((env_id, objective))
-    if name is None:
-        return None
     from optimal.lqr import TimeVaryingLQR
 
-    reference = load_reference(name)
-    controller = TimeVaryingLQR(reference)
-
-    def make_policy(_env: Any) -> TimeVaryingLQR:
-        controller.reset()
-        return controller
-
-    return Controller(LQR, make_policy, row_env_options(reference))
+    return reference_controller(LQR, TimeVaryingLQR, env_id, objective, needs_casadi=False)
 
 
 def mpc_controller(env_id: str, objective: str) -> Controller | None:
     """The MPC around the reference of (env id, objective); None without a reference or CasADi."""
-    name = REFERENCE_NAMES.get((env_id, objective))
-    if name is None or importlib.util.find_spec("casadi") is None:
-        return None
     from optimal.mpc import ShrinkingHorizonMPC
 
-    reference = load_reference(name)
-    controller = ShrinkingHorizonMPC(reference)
-
-    def make_policy(_env: Any) -> ShrinkingHorizonMPC:
-        controller.reset()  # a new episode: the plan goes, the built NLPs stay
-        return controller
-
-    return Controller(MPC, make_policy, row_env_options(reference))
+    return reference_controller(MPC, ShrinkingHorizonMPC, env_id, objective)
 
 
 def tracking_controller(env_id: str, objective: str) -> Controller | None:
     """The tracking MPC along the reference of (env id, objective); None without one or CasADi."""
-    name = REFERENCE_NAMES.get((env_id, objective))
-    if name is None or importlib.util.find_spec("casadi") is None:
-        return None
     from optimal.tracking import TrackingMPC
 
-    reference = load_reference(name)
-    built: list[TrackingMPC] = []  # built on the first episode: a row not played costs nothing
+    return reference_controller(TRACKING, TrackingMPC, env_id, objective)
 
-    def make_policy(_env: Any) -> TrackingMPC:
+
+def reference_controller(label: str, controller_class: Callable[[Reference], Any], env_id: str,
+                         objective: str, needs_casadi: bool = True) -> Controller | None:
+    """The row ``label``: ``controller_class(reference)`` along the reference of the task.
+
+    None without a reference for (env id, objective), or without CasADi when ``needs_casadi``.
+    The controller is built at the row's first episode (a row not played costs nothing) and
+    serves every episode, reset at each (its built NLPs or gains stay).
+    """
+    name = REFERENCE_NAMES.get((env_id, objective))
+    if name is None or (needs_casadi and importlib.util.find_spec("casadi") is None):
+        return None
+    reference = load_reference(name)
+    built: list[Any] = []
+
+    def make_policy(_env: Any) -> Any:
         if not built:
-            built.append(TrackingMPC(reference))
+            built.append(controller_class(reference))
         built[0].reset()
         return built[0]
 
-    return Controller(TRACKING, make_policy, row_env_options(reference))
+    return Controller(label, make_policy, row_env_options(reference))
 
 
 EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
@@ -107,4 +98,4 @@ MPC (milliseconds), the shrinking-horizon MPC (0.1-1 s)."""
 
 
 __all__ = ["EXPERTS", "LQR", "MPC", "TRACKING", "lqr_controller", "mpc_controller",
-           "row_env_options", "tracking_controller"]
+           "reference_controller", "row_env_options", "tracking_controller"]

@@ -18,14 +18,12 @@ a control step is one matrix-vector product.
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from mdi_envs._types import FloatArray
 from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER, MANIPULATOR_MANEUVER
 from mdi_envs.stepping import MoreauJeanStepper
-from optimal.observations import decode_observation
+from optimal.observations import StateFeedbackPolicy
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
 
@@ -121,7 +119,7 @@ def state_weight(reference: Reference) -> FloatArray:
     return np.diag(weights)
 
 
-class TimeVaryingLQR:
+class TimeVaryingLQR(StateFeedbackPolicy):
     """The time-varying LQR along ``reference`` (see the module docstring).
 
     Args:
@@ -168,18 +166,9 @@ class TimeVaryingLQR:
         """A new episode: the step counter and the compute records start again."""
         self.compute_times = []
 
-    def __call__(self, observation: FloatArray) -> FloatArray:
-        """The env action (default Box space) for an observation of the reference's env."""
-        clock = time.process_time()
-        step = len(self.compute_times)
-        target = self._x[min(step, len(self._tau))]
-        q, u = decode_observation(observation, target[:target.size // 2], self.has_brake)
-        tau, brake = self.control(step, q, u)
-        action = [tau / self.torque_bound]
-        if self.has_brake:
-            action.append(np.where(brake > 0.0, 1.0, -1.0))
-        self.compute_times.append(time.process_time() - clock)
-        return np.concatenate(action).astype(np.float32)
+    def predicted_q(self, step: int) -> FloatArray:
+        """(n,) the reference's q at env step ``step`` (its last past the end)."""
+        return self.reference.q[min(step, len(self._tau))]
 
     def control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""

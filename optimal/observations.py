@@ -4,12 +4,14 @@ The manipulator's observation carries its angles as (cos, sin) pairs, the robot'
 the goal offset and heading error and its velocity in the body frame; neither carries the
 robot's wheel angles, on which no dynamics depend. ``decode_observation`` inverts that against
 a predicted q (the controller's plan or reference): angles are unwrapped to the branch nearest
-the prediction and the wheel angles are taken from it.
+the prediction and the wheel angles are taken from it. ``StateFeedbackPolicy`` is the env policy
+of a controller that acts on (q, u): decode, control, encode the action, time the call.
 """
 
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -47,4 +49,38 @@ def decode_observation(observation: FloatArray, predicted_q: FloatArray,
     return q, u
 
 
-__all__ = ["decode_observation"]
+class StateFeedbackPolicy:
+    """An env policy (default Box action space) from a state feedback ``control(step, q, u)``.
+
+    Subclasses set ``has_brake``, ``torque_bound`` [N m] and ``compute_times`` (reset per
+    episode) and define ``control`` and ``predicted_q``; a call decodes the observation against
+    ``predicted_q(step)``, applies ``control`` at the step (the number of calls this episode),
+    encodes the torques and brake bounds as the Box action and records its CPU time [s].
+    """
+
+    has_brake: bool
+    torque_bound: float
+    compute_times: list[float]
+
+    def predicted_q(self, step: int) -> FloatArray:
+        """(n,) the q expected at env step ``step`` (angles unwrapped near it)."""
+        raise NotImplementedError
+
+    def control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""
+        raise NotImplementedError
+
+    def __call__(self, observation: FloatArray) -> FloatArray:
+        """The env action for an observation of the reference's env."""
+        clock = time.process_time()
+        step = len(self.compute_times)
+        q, u = decode_observation(observation, self.predicted_q(step), self.has_brake)
+        tau, brake = self.control(step, q, u)
+        action = [tau / self.torque_bound]
+        if self.has_brake:
+            action.append(np.where(brake > 0.0, 1.0, -1.0))
+        self.compute_times.append(time.process_time() - clock)
+        return np.concatenate(action).astype(np.float32)
+
+
+__all__ = ["StateFeedbackPolicy", "decode_observation"]
