@@ -20,17 +20,20 @@ which ends at rest, are its neighbour's.
 
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
-dual start) (``Opti.to_function``); a control step is one call, warm-started from the previous
-step's solution shifted by one interval (and its multipliers; after a failed step, the last
-solution shifted as far), or from the reference window on the first step. IPOPT runs from a
-small barrier parameter to a loose tolerance (``SOLVER_OPTIONS``) and at most
-``MAX_ITERATIONS`` iterations; if it fails, the LQR's control is applied (``fallbacks``).
+dual start) (``Opti.to_function``); a control step is one call. Its primal start is the last
+solution shifted by the intervals since it was found, its multipliers that solution's; the
+intervals the shifted plan does not cover (the last one, or more after failed steps), and the
+whole first step, take the reference's own point of the window (one per window, computed in the
+constructor), a consistent point of the fixed modes (repeating the plan's last interval
+instead breaks the dynamics there, from where IPOPT converges to local minima of the window far
+off the reference). IPOPT runs from a small barrier
+parameter to a loose tolerance (``SOLVER_OPTIONS``) and at most ``MAX_ITERATIONS`` iterations;
+if it fails, the LQR's control is applied (``fallbacks``) and its last iterate is dropped.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import time
 from typing import Any
 
 import numpy as np
@@ -39,7 +42,7 @@ from mdi_envs._types import FloatArray
 from optimal.continuation import POLISH_RELAXATION
 from optimal.lqr import TimeVaryingLQR
 from optimal.modes import ModePattern
-from optimal.observations import decode_observation
+from optimal.observations import StateFeedbackPolicy
 from optimal.problems import make_problem
 from optimal.references import Reference
 from optimal.transcription import GUESS_IMPULSES, Transcription
@@ -69,7 +72,7 @@ class _Window:
     shapes: list[tuple[int, int]]
 
 
-class TrackingMPC:
+class TrackingMPC(StateFeedbackPolicy):
     """The receding-horizon tracking MPC along ``reference`` (see the module docstring).
 
     Args:
@@ -112,7 +115,7 @@ class TrackingMPC:
                                          np.repeat(self.lqr.hold_cost_to_go[None], extension, 0)])
         self._windows: dict[bytes, _Window] = {}
         self._keys = [self._window(k) for k in range(steps + (1 if extension else 0))]
-        self._first = self._reference_point()
+        self._reference_points = [self._reference_point(k) for k in range(len(self._keys))]
         self.compute_times: list[float] = []
         self.fallbacks: list[int] = []
         self.iterations: list[int] = []
@@ -123,18 +126,10 @@ class TrackingMPC:
         self.compute_times, self.fallbacks, self.iterations = [], [], []
         self._previous = None
 
-    def __call__(self, observation: FloatArray) -> FloatArray:
-        """The env action (default Box space) for an observation of the reference's env."""
-        clock = time.process_time()
-        step = len(self.compute_times)
-        predicted = self._x[min(step, len(self._keys) - 1)]
-        q, u = decode_observation(observation, predicted[:predicted.size // 2], self.has_brake)
-        tau, brake = self.control(step, q, u)
-        action = [tau / self.torque_bound]
-        if self.has_brake:
-            action.append(np.where(brake > 0.0, 1.0, -1.0))
-        self.compute_times.append(time.process_time() - clock)
-        return np.concatenate(action).astype(np.float32)
+    def predicted_q(self, step: int) -> FloatArray:
+        """(n,) the reference's q at env step ``step`` (the goal past the end)."""
+        x = self._x[min(step, len(self._keys) - 1)]
+        return x[:x.size // 2]
 
     def control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""
@@ -144,10 +139,14 @@ class TrackingMPC:
         k = min(step, len(self._keys) - 1)
         window = self._windows[self._keys[k]]
         lam_size = window.transcription.opti.lam_g.shape[0]
-        last, x_last, lam_last, solved_at = self._previous or (
-            self._windows[self._keys[0]], self._first, np.zeros(0), 0)
-        x0 = x_last[_shift_indices(last.shapes, window.shapes, step - solved_at)]
-        lam0 = lam_last if lam_last.size == lam_size else np.zeros(lam_size)
+        reference = self._reference_points[k]
+        if self._previous is None:
+            x0, lam0 = reference, np.zeros(lam_size)
+        else:
+            last, x_last, lam_last, solved_at = self._previous
+            x0 = np.concatenate([x_last, reference])[
+                _shift_indices(last.shapes, window.shapes, k - solved_at)]
+            lam0 = lam_last if lam_last.size == lam_size else np.zeros(lam_size)
         length = window.shapes[0][1] - 1  # intervals: q has one column per node
         end = k + length
         x, lam, tau = window.solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
@@ -156,11 +155,11 @@ class TrackingMPC:
         self.iterations.append(int(stats.get("iter_count", -1)))
         brake = self._brake[k] if self._brake is not None else np.zeros(0)
         success = bool(stats.get("success", False))
-        self._previous = (window, np.asarray(x, dtype=float).ravel(),
-                          np.asarray(lam, dtype=float).ravel() if success else np.zeros(0), step)
-        if not success:  # the next step starts from this last iterate, multipliers zero
+        if not success:  # the next step starts from the last solution, shifted further
             self.fallbacks.append(step)
             return self.lqr.control(step, q, u)[0], brake
+        self._previous = (window, np.asarray(x, dtype=float).ravel(),
+                          np.asarray(lam, dtype=float).ravel(), k)
         tau0 = np.asarray(tau, dtype=float).reshape(-1, length)[:, 0]
         return np.clip(tau0, -self.torque_bound, self.torque_bound), brake
 
@@ -202,30 +201,39 @@ class TrackingMPC:
                                  [opti.x, opti.lam_g, t.tau])
         return _Window(t, solve, [raw.shape for raw, _ in t._raw.values()])
 
-    def _reference_point(self) -> FloatArray:
-        """The NLP point of the reference's first window (the first step's warm start)."""
-        t = self._windows[self._keys[0]].transcription
-        span = slice(0, self.horizon)
+    def _reference_point(self, k: int) -> FloatArray:
+        """The NLP point of window k on the reference (its warm start where no plan is)."""
+        window = self._windows[self._keys[k]]
+        length, n = window.shapes[0][1] - 1, self.base.model.NUM_DOFS
+        span = slice(k, k + length)
         impulses = {key: np.asarray(self.reference.arrays[key][span], dtype=float)
                     for key in GUESS_IMPULSES if key in self.reference.arrays}
-        t.set_guess(self.reference.q[:self.horizon + 1], self.reference.u[:self.horizon + 1],
-                    self.reference.tau[span], self.horizon * self.reference.time_step, impulses)
-        return t.initial_point()
+        x = self._x[k:k + length + 1]
+        window.transcription.set_guess(x[:, :n], x[:, n:], self._tau[span],
+                                       length * self.reference.time_step, impulses)
+        return window.transcription.initial_point()
 
 
 def _shift_indices(old: list[tuple[int, int]], new: list[tuple[int, int]],
                    by: int) -> np.ndarray:
-    """Indices into an NLP's variables (shapes ``old``) that make another's (shapes ``new``).
+    """Indices into (old point, fill point) that make a start of another NLP (shapes ``new``).
 
     Every variable of a ``Transcription`` is a (rows, columns) matrix over the grid's nodes or
-    intervals, stored column-major in declaration order; each new column j takes the old
-    column j + ``by`` (the plan ``by`` intervals on), the last old column where there is none.
+    intervals, stored column-major in declaration order: the old point has the shapes ``old``,
+    the fill point (appended after it) the shapes ``new``. Each new column j takes the old
+    column j + ``by`` (the plan ``by`` intervals on), the fill point's column j where there is
+    none.
     """
     indices, offset = [], 0
+    filler = sum(rows * columns for rows, columns in old)
     for (rows, columns), (_, new_columns) in zip(old, new, strict=True):
+        source = np.arange(new_columns) + by
         block = offset + np.arange(rows * columns).reshape(columns, rows)
-        indices.append(block[np.minimum(np.arange(new_columns) + by, columns - 1)].ravel())
+        fill = filler + np.arange(rows * new_columns).reshape(new_columns, rows)
+        indices.append(np.where((source < columns)[:, None],
+                                block[np.minimum(source, columns - 1)], fill).ravel())
         offset += rows * columns
+        filler += rows * new_columns
     return np.concatenate(indices)
 
 

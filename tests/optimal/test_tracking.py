@@ -48,9 +48,13 @@ def test_from_a_perturbed_start_it_reaches_the_goal_in_the_optimal_time(
 
 
 def test_the_warm_start_shifts_every_variable_by_whole_intervals() -> None:
-    """Two variables, (2, 3) and (1, 2), column-major: one interval on, the last repeated."""
+    """Two variables, (2, 3) and (1, 2), column-major, then the new window's reference point.
+
+    Each new column j takes the old column j + 1; where there is none, the reference point's
+    column j (its entries follow the old point's 8).
+    """
     old = [(2, 3), (1, 2)]
-    np.testing.assert_array_equal(_shift_indices(old, old, 1), [2, 3, 4, 5, 4, 5, 7, 7])
+    np.testing.assert_array_equal(_shift_indices(old, old, 1), [2, 3, 4, 5, 12, 13, 7, 15])
     np.testing.assert_array_equal(_shift_indices(old, [(2, 2), (1, 1)], 1), [2, 3, 4, 5, 7])
     np.testing.assert_array_equal(_shift_indices(old, old, 0), np.arange(8))
 
