@@ -1,4 +1,5 @@
-# Entry points: `make demo` (the main job), `make test` (every test, then the quick benchmarks)
+# Entry points: `make demo` (the main job), `make test` (every test, then the quick benchmarks
+# but the stress cases and work-precision, whose quick runs are tests)
 # and `make test-fast` (the inner loop: the tests not marked slow). Each creates .venv and
 # installs what it needs. CI sets TORCH_SPEC=torch==2.13.0 so that pip takes the local CPU wheel
 # before anything can pull the CUDA build; ordinary users leave it empty and get torch the normal
@@ -30,7 +31,7 @@ demo: $(VENV)/.installed-rl,render
 test: $(VENV)/.installed-test
 	$(BIN)/mdi-envs compile all
 	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=10
-	$(BIN)/python -m mdi_envs bench --quick --skip stress
+	$(BIN)/python -m mdi_envs bench --quick --skip stress precision
 
 # The inner loop while editing: every test but those marked slow (training, optimisation,
 # full-size solver and benchmark studies), the same as `pytest -m "not slow"`.
