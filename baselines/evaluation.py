@@ -30,6 +30,13 @@ import gymnasium as gym
 import numpy as np
 from tqdm import tqdm
 
+from baselines.hyperparameters import (
+    DIFF_DRIVE,
+    DIFF_DRIVE_EFFORT_V1,
+    DIFF_DRIVE_V1,
+    MANIPULATOR,
+    MANIPULATOR_V1,
+)
 from baselines.records import (
     OPTIMAL,
     Aggregate,
@@ -52,12 +59,6 @@ from optimal.replay import env_actions, env_options
 
 TRAINED_DIR = Path(__file__).parent / "trained"
 """Where the shipped policies live: ``STEM.zip`` + ``STEM.json`` (see ``baselines.train``)."""
-
-MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
-DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
-MANIPULATOR_V1 = "mdi_envs/BlockableManipulator-v1"
-DIFF_DRIVE_V1 = "mdi_envs/DiffDriveRobot-v1"
-DIFF_DRIVE_EFFORT_V1 = "mdi_envs/DiffDriveRobotEffort-v1"
 
 REFERENCE_NAMES = {
     (MANIPULATOR, "time"): "manipulator_time",

@@ -28,6 +28,9 @@ from typing import Any
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
+MANIPULATOR_V1 = "mdi_envs/BlockableManipulator-v1"
+DIFF_DRIVE_V1 = "mdi_envs/DiffDriveRobot-v1"
+DIFF_DRIVE_EFFORT_V1 = "mdi_envs/DiffDriveRobotEffort-v1"
 ALGORITHMS = ("PPO", "SAC", "TQC", "CrossQ", "HybridPPO")
 """The algorithm names, canonical spelling (lookups are case-insensitive)."""
 ALGORITHM_CLASSES = {
@@ -48,8 +51,10 @@ HYPERPARAMS_DIR = Path(__file__).parent / "hyperparams"
 DEFAULT_SEED = 0
 """The seed of a run when none is given (rl-zoo3: ``--seed 0``)."""
 
-DEFAULT_OBJECTIVES = {MANIPULATOR: "time", DIFF_DRIVE: "time"}
-"""The objective used when none is given (the manipulator has only "time")."""
+DEFAULT_OBJECTIVES = {MANIPULATOR: "time", DIFF_DRIVE: "time", MANIPULATOR_V1: "time",
+                      DIFF_DRIVE_V1: "time", DIFF_DRIVE_EFFORT_V1: "effort"}
+"""The trainable env ids and the objective used when none is given: a v0 id takes it as an env
+argument (the manipulator has only "time"), a v1 id has one objective, its own."""
 
 _NORMALIZE_REWARD = {"norm_obs": False, "norm_reward": True}
 """rl-zoo3's ``normalize`` value of the entries with ``normalize_reward``."""
@@ -124,9 +129,10 @@ def get_hyperparameters(env_id: str, algo: str, objective: str | None = None) ->
     """A deep copy of the table entry.
 
     Args:
-        env_id: ``mdi_envs/BlockableManipulator-v0`` or ``mdi_envs/DiffDriveRobot-v0``.
-        algo: "PPO", "SAC" or "HybridPPO" (case-insensitive; HybridPPO: manipulator only).
-        objective: "time" or "effort" (diff drive only); default ``DEFAULT_OBJECTIVES[env_id]``.
+        env_id: a key of ``DEFAULT_OBJECTIVES`` (the v0 and v1 mission ids).
+        algo: an ``ALGORITHMS`` name (case-insensitive; HybridPPO: manipulator only).
+        objective: "time" or "effort" (the v0 diff drive only); default
+            ``DEFAULT_OBJECTIVES[env_id]``.
 
     Raises:
         KeyError: no entry for this combination (the message lists the known keys).
@@ -141,7 +147,8 @@ def get_hyperparameters(env_id: str, algo: str, objective: str | None = None) ->
 
 
 __all__ = [
-    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_SEED", "DEFAULT_OBJECTIVES", "HYPERPARAMS_DIR",
+    "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_SEED", "DEFAULT_OBJECTIVES", "DIFF_DRIVE",
+    "DIFF_DRIVE_EFFORT_V1", "DIFF_DRIVE_V1", "HYPERPARAMS_DIR", "MANIPULATOR", "MANIPULATOR_V1",
     "canonical_algorithm", "entry_from_zoo", "get_hyperparameters", "hyperparameter_file",
     "hyperparameter_table",
 ]

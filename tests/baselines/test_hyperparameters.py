@@ -9,6 +9,7 @@ import mdi_envs  # noqa: F401 - registers the ids
 from baselines.hyperparameters import (
     ALGORITHM_CLASSES,
     ALGORITHMS,
+    DEFAULT_OBJECTIVES,
     HYPERPARAMS_DIR,
     canonical_algorithm,
     entry_from_zoo,
@@ -47,6 +48,28 @@ def test_every_entry_fixes_the_shaping_discount_and_lookups_copy() -> None:
     assert fresh["algo_kwargs"]["gamma"] == 0.99 and fresh["env_kwargs"]["goal_weight"] == 1000.0
     with pytest.raises(KeyError, match="known"):
         get_hyperparameters("mdi_envs/BlockableManipulator-v0", "PPO", "effort")
+
+
+def test_every_id_of_the_table_trains_with_its_default_objective() -> None:
+    assert set(DEFAULT_OBJECTIVES) == {env_id for env_id, _, _ in HYPERPARAMETERS}
+    for (env_id, objective, algo), entry in HYPERPARAMETERS.items():
+        if env_id.endswith("-v1"):  # one objective per v1 id: no objective needed
+            assert objective == DEFAULT_OBJECTIVES[env_id]
+            assert get_hyperparameters(env_id, algo) == entry
+    with pytest.raises(KeyError, match="DiffDriveRobot-v1 effort PPO"):
+        get_hyperparameters("mdi_envs/DiffDriveRobot-v1", "PPO", "effort")
+
+
+def test_the_train_command_takes_every_id_of_the_table() -> None:
+    import argparse
+
+    from baselines.cli import add_train_parser
+
+    parser = argparse.ArgumentParser()
+    add_train_parser(parser.add_subparsers())
+    for env_id in DEFAULT_OBJECTIVES:
+        args = parser.parse_args(["train", env_id, "ppo"])
+        assert (args.env_id, args.algo) == (env_id, "PPO")
 
 
 def test_hybrid_ppo_uses_the_ppo_settings_on_the_hybrid_space() -> None:
