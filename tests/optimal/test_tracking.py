@@ -47,6 +47,24 @@ def test_from_a_perturbed_start_it_reaches_the_goal_in_the_optimal_time(
     assert len(controller.compute_times) == len(controller.iterations)
 
 
+def test_on_the_reference_the_next_warm_start_is_the_reference(controller: TrackingMPC) -> None:
+    """The plan shifted by one interval, its new last interval from the reference's point.
+
+    On the reference the plan is the reference, so the next window's start (trajectory and
+    torques, the first three variables) is that window's reference point, its last interval
+    included (the plan's last interval repeated there is 0.09 off in the NLP's units).
+    """
+    reference = controller.reference
+    controller.reset()
+    controller.control(0, reference.q[0], reference.u[0])
+    last, plan, _, solved_at = controller._previous
+    window = controller._windows[controller._keys[1]]
+    start = np.concatenate([plan, controller._reference_points[1]])[
+        _shift_indices(last.shapes, window.shapes, 1 - solved_at)]
+    size = sum(rows * columns for rows, columns in window.shapes[:3])
+    np.testing.assert_allclose(start[:size], controller._reference_points[1][:size], atol=1e-2)
+
+
 def test_the_warm_start_shifts_every_variable_by_whole_intervals() -> None:
     """Two variables, (2, 3) and (1, 2), column-major, then the new window's reference point.
 
