@@ -18,7 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from baselines.records import OPTIMAL, Episode, Estimate, Row, Study
+from baselines.records import OPTIMAL, Episode, Estimate, Row, Run, Study
 
 
 def interval_text(estimate: Estimate, percent: bool = False) -> str:
@@ -60,9 +60,9 @@ def _nominal_text(row: Row, condition: str) -> str:
             if nominal.is_success else "fails")  # fmt: skip
 
 
-def _compute_text(row: Row, condition: str) -> str:
-    """The mean wall time of one policy call over the row's perturbed episodes."""
-    times = [run.scores.compute_per_step for run in row.at(condition)]
+def _compute_text(runs: Sequence[Run]) -> str:
+    """The mean wall time of one policy call over the runs' perturbed episodes."""
+    times = [run.scores.compute_per_step for run in runs]
     if any(t is None for t in times):
         return "-"
     seconds = float(np.mean(times))
@@ -95,7 +95,7 @@ def comparison_table(studies: Sequence[Study]) -> str:
                 label = condition.label
                 records.append([study.env_id.split("/")[-1], study.objective,
                                 f"{condition.scale:g}", row.label, count, *cells,
-                                _nominal_text(row, label), _compute_text(row, label),
+                                _nominal_text(row, label), _compute_text(row.at(label)),
                                 budget_text(row, label)])  # fmt: skip
     columns = ["env", "objective", "start scale", "controller", "runs",
                "success (perturbed starts), IQM [95 % CI]", "time / optimal",
@@ -205,7 +205,8 @@ def robustness_table(studies: Sequence[Study]) -> str:
     """Per study a title line and a table: success (ratio over the successes) per condition.
 
     Success is the mean over the row's runs, the ratio the mean over its runs with successes
-    (each row's aggregates: ``evaluation.aggregate``).
+    (each row's aggregates: ``evaluation.aggregate``); the last column is the mean wall time of
+    one policy call over all of the row's runs.
     """
     parts = []
     for study in studies:
@@ -222,9 +223,11 @@ def robustness_table(studies: Sequence[Study]) -> str:
                 runs = max(runs, estimates.success_rate.n)
                 cells.append(f"{estimates.success_rate.mean or 0.0:.0%}"
                              + ("" if mean is None else f" ({mean:.2f})"))
-            records.append([row.label, runs, *cells])
+            played = [run for c in study.conditions for run in row.at(c.label)]
+            records.append([row.label, runs, *cells, _compute_text(played)])
         table = pd.DataFrame(records, columns=["controller", "runs",
-                                               *(c.label for c in study.conditions)])
+                                               *(c.label for c in study.conditions),
+                                               "compute / step"])
         parts.append(f"{study.env_id} {study.objective} ({study.num_starts} starts per run; "
                      f"success, {ratio}/optimal over the successes)\n\n"
                      + table.to_markdown(index=False))
