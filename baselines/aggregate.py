@@ -26,6 +26,7 @@ seeds that generator and restores its previous state afterwards (``_seeded``).
 from __future__ import annotations
 
 import contextlib
+import functools
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -143,8 +144,16 @@ def improvement_probability(x: Sequence[float], y: Sequence[float], reps: int = 
     """P(X > Y) over runs (one score per run of X and of Y) and its 95 % CI.
 
     The CI (rliable's independent stratified bootstrap of both samples) is None when neither
-    has two runs or ``reps`` is 0.
+    has two runs or ``reps`` is 0. Results are memoized per (x, y, reps, seed): a comparison
+    report asks for the same pairs in its summary and in each study's table.
     """
+    return _improvement_probability(tuple(map(float, x)), tuple(map(float, y)), reps, seed)
+
+
+@functools.lru_cache(maxsize=4096)
+def _improvement_probability(x: tuple[float, ...], y: tuple[float, ...], reps: int,
+                             seed: int) -> tuple[float, tuple[float, float] | None]:
+    """``improvement_probability`` on hashable samples."""
     from rliable import library
 
     scores = (np.asarray(x, dtype=float)[:, None], np.asarray(y, dtype=float)[:, None])
