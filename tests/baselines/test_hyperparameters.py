@@ -29,7 +29,10 @@ def test_table_covers_both_envs_tasks_and_algorithms() -> None:
                 "normalize_reward"} <= set(entry)
         assert isinstance(entry["normalize_reward"], bool)
         assert isinstance(entry["seed"], int) and entry["num_envs"] >= 1
-        assert entry["algo_kwargs"]["gamma"] == 0.99
+        if env_id.endswith("-v0"):  # set by hand; a v1 entry's gamma may come from the search
+            assert entry["algo_kwargs"]["gamma"] == 0.99
+        else:
+            assert entry["algo_kwargs"]["gamma"] in (0.98, 0.99, 0.995, 0.999)
 
 
 def test_every_entry_fixes_the_shaping_discount_and_lookups_copy() -> None:
