@@ -46,6 +46,7 @@ DATASET_EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
 }  # fmt: skip
 """The reference open loop and the feedback experts (``baselines.model_based.EXPERTS``)."""
 
+
 def dataset_id(env_id: str, expert: str, version: int = 0) -> str:
     """``mdi_envs/<Task>/<expert>-v<version>``, e.g. ``mdi_envs/DiffDriveRobot/lqr-v0``."""
     task = env_id.split("/")[-1].rsplit("-v", 1)[0]

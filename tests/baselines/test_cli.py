@@ -114,12 +114,13 @@ def test_robustness_writes_json_plot_and_table(tmp_path: Path) -> None:
 
 
 def test_the_shipped_tables_are_made_from_the_shipped_studies() -> None:
-    comparisons = [read_study(p) for p in sorted((RESULTS / "comparison").glob("compare_*.json"))]
-    assert len(comparisons) == 3
-    assert (RESULTS / "comparison" / "compare.md").read_text() == comparison_report(comparisons)
-    for study in comparisons:
-        table = (RESULTS / "comparison" / f"compare_{study.name}.md").read_text()
-        assert table == comparison_report([study])
+    for folder in (RESULTS / "comparison", RESULTS / "distilled" / "comparison"):
+        comparisons = [read_study(p) for p in sorted(folder.glob("compare_*.json"))]
+        assert len(comparisons) == 3
+        assert (folder / "compare.md").read_text() == comparison_report(comparisons)
+        for study in comparisons:
+            assert (folder / f"compare_{study.name}.md").read_text() == comparison_report(
+                [study])
     studies = [read_study(p) for p in sorted((RESULTS / "robustness").glob("robustness_*.json"))]
     assert (RESULTS / "robustness" / "robustness.md").read_text().strip() == robustness_table(
         studies)
