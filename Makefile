@@ -3,8 +3,9 @@
 # and `make test-fast` (the inner loop: the tests not marked slow). Each creates .venv and
 # installs what it needs. CI sets TORCH_SPEC=torch==2.13.0 so that pip takes the local CPU wheel
 # before anything can pull the CUDA build; ordinary users leave it empty and get torch the normal
-# way when they install the `rl` extra. Each first compiles every env kernel into the disk cache
-# (`mdi-envs compile all`), so that the processes after it start warm. The tests run on every core
+# way when they install the `rl` extra. Each first compiles the env kernels it uses into the disk
+# cache (`mdi-envs compile all`; the demo only what gym.make needs, `--make-only`), so that the
+# processes after it start warm. The tests run on every core
 # (pytest-xdist); --dist loadfile keeps each file on one worker, so that a module's fixture (the
 # kernel-cache tests compile into an empty cache) runs once, and tests/conftest.py hands out the
 # files with the most slow tests first.
@@ -25,7 +26,7 @@ $(VENV)/.installed-%: pyproject.toml
 	touch $@
 
 demo: $(VENV)/.installed-rl,render
-	$(BIN)/mdi-envs compile all
+	$(BIN)/mdi-envs compile all --make-only
 	$(BIN)/mdi-envs demo --output results/demo
 
 test: $(VENV)/.installed-test

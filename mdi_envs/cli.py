@@ -109,6 +109,9 @@ def _build_parser(command: str | None) -> argparse.ArgumentParser:
                           help="ids to compile, or 'all' (default)")
     compile_.add_argument("--jobs", type=int, default=None,
                           help="worker processes (default: one per core)")
+    compile_.add_argument("--make-only", action="store_true",
+                          help="only what gym.make needs (each id and its documented variants): "
+                          "no vector env, no stepper; about 60 %% of the time on an empty cache")
     compile_.set_defaults(handler=_run_compile)
 
     for name, entry in plugin_commands().items():
@@ -139,12 +142,13 @@ def _add_plugin(commands: Any, name: str, entry: EntryPoint) -> None:
 def _run_compile(args: argparse.Namespace) -> int:
     from mdi_envs import ENV_IDS
     from mdi_envs._kernel_cache import digest_dir
-    from mdi_envs.precompile import compile_envs
+    from mdi_envs.precompile import MAKE_STAGES, STAGES, compile_envs
 
     env_ids = list(ENV_IDS) if "all" in args.env_ids else args.env_ids
     started = time.perf_counter()
     try:
-        seconds = compile_envs(env_ids, jobs=args.jobs)
+        seconds = compile_envs(env_ids, jobs=args.jobs,
+                               stages=MAKE_STAGES if args.make_only else STAGES)
     except (ValueError, RuntimeError) as error:
         print(f"mdi-envs compile: {error}", file=sys.stderr)
         return 2

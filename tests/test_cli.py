@@ -84,3 +84,23 @@ def test_solve_reports_a_ray_with_exit_code(tmp_path: Path) -> None:
     path = tmp_path / "infeasible.dat"
     path.write_text("2\n0\n2\n2\n2 2\n-1 0\n0 -1\n-1 -1\n")
     assert main(["solve", str(path)]) == 1
+
+
+def test_compile_runs_the_stages_asked_for_in_order() -> None:
+    from mdi_envs.precompile import MAKE_STAGES, compile_env
+
+    reported: list[str] = []
+    compile_env("mdi_envs/SlidingBlock-v0", lambda stage, seconds: reported.append(stage),
+                MAKE_STAGES)
+    assert reported == ["env", "variants"]
+
+
+def test_compile_refuses_an_unknown_stage_or_id(capsys: pytest.CaptureFixture[str]) -> None:
+    from mdi_envs.precompile import compile_env, compile_envs
+
+    with pytest.raises(ValueError, match=r"unknown stage\(s\) \['gpu'\]"):
+        compile_envs(["mdi_envs/SlidingBlock-v0"], stages=("env", "gpu"), progress=False)
+    with pytest.raises(ValueError, match="unknown env id 'mdi_envs/Nothing-v0'"):
+        compile_env("mdi_envs/Nothing-v0")
+    assert main(["compile", "mdi_envs/Nothing-v0", "--make-only"]) == 2
+    assert "unknown env id(s) ['mdi_envs/Nothing-v0']" in capsys.readouterr().err
