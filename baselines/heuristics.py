@@ -130,10 +130,7 @@ def speed_profile(s: np.ndarray, curvature: np.ndarray, max_acceleration: float,
 
 def rolling_path_follower(env: gym.Env[Any, Any], final_time: float | None = None,
                           via: tuple[float, float] = (0.9, 2.5), handle: float = 0.8,
-                          approach: float = 0.5,
-                          max_acceleration: float = 1.5, max_speed: float = 4.0,
-                          max_wheel_torque: float = 2.0,
-                          margin: float = 0.1) -> Policy:  # fmt: skip
+                          approach: float = 0.5, **limits: float) -> Policy:  # fmt: skip
     """The rolling path follower (module docstring) for the diff-drive ``env``.
 
     Args:
@@ -142,15 +139,11 @@ def rolling_path_follower(env: gym.Env[Any, Any], final_time: float | None = Non
         via: (x, y) [m] where the axle, after the start's left turn, heads straight up (+y)
             to the right half-turn (radius (goal x - via x) / 2) that ends ``approach`` [m]
             above the goal, from where it heads straight down into the goal.
-        handle: [m] the first segment's Bezier handles. max_acceleration: [m/s^2] of the
-            axle point, tangential and centripetal together. max_speed: [m/s].
-        max_wheel_torque: [N m] the clip, below the ~2.2 N m rolling traction limit of the
-            default robot. margin: [s] the path ends this long before ``final_time`` (if
-            it can; otherwise the profile is kept as it is).
+        handle: [m] the first segment's Bezier handles.
+        limits: ``path_follower``'s speed, acceleration and torque limits.
     """
     unwrapped = env.unwrapped
-    p, dt = unwrapped.scene.parameters, unwrapped.dt
-    a = p.axle_offset
+    a = unwrapped.scene.parameters.axle_offset
     x0, y0, phi0 = DIFF_DRIVE_MANEUVER.initial_pose
     start = (x0 - a * math.cos(phi0), y0 - a * math.sin(phi0), phi0)
     gx, gy, gphi = DIFF_DRIVE_MANEUVER.goal_pose
@@ -159,8 +152,65 @@ def rolling_path_follower(env: gym.Env[Any, Any], final_time: float | None = Non
     top = goal[1] + approach  # the half-turn ends this far above the goal, heading down
     poses = [start, (*via, math.pi / 2), (via[0], top, math.pi / 2), (goal[0], top, -math.pi / 2),
              goal]
-    s, xy, heading, curvature = bezier_path(
-        poses, [handle, (top - via[1]) / 3, 4 * radius / 3, approach / 3])
+    return path_follower(unwrapped.scene.parameters, unwrapped.dt, unwrapped.scene.max_wheel_torque,
+                         poses, [handle, (top - via[1]) / 3, 4 * radius / 3, approach / 3],
+                         final_time, **limits)
+
+
+PARKING_LIMITS = {"max_acceleration": 1.2, "max_wheel_torque": 1.5}
+"""``parking_follower``'s limits [m/s^2, N m]: within the rolling traction of a robot with 20 %
+less friction than the default (1.76 N m per wheel)."""
+
+
+def parking_follower(parameters: Any, dt: float, action_torque: float, observation: Any,
+                     **limits: float) -> Policy:
+    """A rolling path from the robot's pose in ``observation`` into the goal pose, at rest.
+
+    One Bezier segment (handles a third of the distance) for the driven axle's midpoint,
+    driven forward if the goal lies ahead of the axle, in reverse if behind; followed by
+    ``path_follower`` (the model ``parameters``, env step ``dt`` [s], ``action_torque`` [N m]
+    the env's action scale, ``limits`` over ``PARKING_LIMITS``) from the call on. For a robot
+    at rest near the goal: the recovery of a controller whose plan ended outside the goal box.
+    """
+    a = parameters.axle_offset
+    gx, gy, gphi = DIFF_DRIVE_MANEUVER.goal_pose
+    phi = math.atan2(observation[3], observation[2]) + gphi
+    x = float(observation[0]) + gx - a * math.cos(phi)
+    y = float(observation[1]) + gy - a * math.sin(phi)
+    goal = (gx - a * math.cos(gphi), gy - a * math.sin(gphi))
+    dx, dy = goal[0] - x, goal[1] - y
+    reverse = dx * math.cos(phi) + dy * math.sin(phi) < 0.0
+    turn = math.pi if reverse else 0.0  # the driving direction's heading
+    poses = [(x, y, phi + turn), (*goal, gphi + turn)]
+    handle = max(math.hypot(dx, dy) / 3, 1e-3)
+    return path_follower(parameters, dt, action_torque, poses, [handle], reverse=reverse,
+                         **{**PARKING_LIMITS, **limits})
+
+
+def path_follower(parameters: Any, dt: float, action_torque: float,
+                  poses: Sequence[Sequence[float]], handles: Sequence[float],
+                  final_time: float | None = None, reverse: bool = False,
+                  max_acceleration: float = 1.5, max_speed: float = 4.0,
+                  max_wheel_torque: float = 2.0, margin: float = 0.1) -> Policy:  # fmt: skip
+    """The tracking law of the module docstring along ``bezier_path(poses, handles)``.
+
+    Args:
+        parameters: the robot model's ``DiffDriveParameters`` the torques are computed with.
+        dt: env step [s] (the path's clock starts at the policy's first call).
+        action_torque: [N m] the env's wheel torque bound (the action's scale).
+        poses, handles: the axle midpoint's path (``bezier_path``), headings in the driving
+            direction. final_time: the fixed horizon [s] of the effort objective (None: as
+            fast as the profile). reverse: driven backwards (headings opposite the chassis').
+        max_acceleration: [m/s^2] of the axle point, tangential and centripetal together.
+        max_speed: [m/s]. max_wheel_torque: [N m] the clip, below the ~2.2 N m rolling
+            traction limit of the default robot. margin: [s] the path ends this long before
+            ``final_time`` (if it can; otherwise the profile is kept as it is).
+    """
+    p = parameters
+    a = p.axle_offset
+    gphi = DIFF_DRIVE_MANEUVER.goal_pose[2]
+    gx, gy = DIFF_DRIVE_MANEUVER.goal_pose[:2]
+    s, xy, heading, curvature = bezier_path(poses, handles)
     v = speed_profile(s, curvature, max_acceleration, max_speed)
     # time along the path: trapezoidal integration of ds / v (v > 0 inside)
     mean_v = np.maximum(0.5 * (v[1:] + v[:-1]), 1e-9)
@@ -174,33 +224,35 @@ def rolling_path_follower(env: gym.Env[Any, Any], final_time: float | None = Non
         / p.wheel_radius**2  # yaw, about the axle point
     stick_load = p.mass * p.gravity * a / (a + p.stick_offset)
     drag = p.stick_friction * stick_load  # [N] the skid's friction while moving
+    direction = -1.0 if reverse else 1.0
+    lever = direction * (a + p.stick_offset)  # the skid ahead of the axle, driving frame
     k_x, k_y, k_phi, k_v, k_w = 2.0, 4.0, 4.0, 6.0, 8.0
     step = [0]
 
     def policy(obs: Any) -> Any:
         now = step[0] * dt
         step[0] += 1
-        phi = math.atan2(obs[3], obs[2]) + gphi
-        x = float(obs[0]) + gx - a * math.cos(phi)
-        y = float(obs[1]) + gy - a * math.sin(phi)
-        forward, yaw_rate = float(obs[4]), float(obs[6])
+        chassis = math.atan2(obs[3], obs[2]) + gphi
+        phi = chassis + (math.pi if reverse else 0.0)
+        x = float(obs[0]) + gx - a * math.cos(chassis)
+        y = float(obs[1]) + gy - a * math.sin(chassis)
+        forward, yaw_rate = direction * float(obs[4]), float(obs[6])
         ref_x, ref_y = np.interp(now, t, xy[:, 0]), np.interp(now, t, xy[:, 1])
         ref_phi = float(np.interp(now, t, heading))
         ref_v = float(np.interp(now, t, v, right=0.0))  # at rest at the goal after the path
         ref_a = float(np.interp(now, t, accel, right=0.0))
         ref_k = float(np.interp(now, t, curvature))
         c, s_ = math.cos(phi), math.sin(phi)
-        e_x = c * (ref_x - x) + s_ * (ref_y - y)  # pose error in the robot frame
+        e_x = c * (ref_x - x) + s_ * (ref_y - y)  # pose error in the driving frame
         e_y = -s_ * (ref_x - x) + c * (ref_y - y)
         e_phi = wrap_angle(ref_phi - phi)
         v_cmd = ref_v * math.cos(e_phi) + k_x * e_x
         w_cmd = ref_v * ref_k + ref_v * k_y * e_y + k_phi * math.sin(e_phi)
-        # the skid's Coulomb friction, along its commanded sliding velocity (body frame),
+        # the skid's Coulomb friction, along its commanded sliding velocity (driving frame),
         # compensated: forward force and yaw moment about the axle
-        lever = a + p.stick_offset
         slide_x, slide_y = v_cmd, w_cmd * lever
         norm = math.sqrt(slide_x * slide_x + slide_y * slide_y + 0.05**2)
-        force = mass * (ref_a + k_v * (v_cmd - forward)) + drag * slide_x / norm
+        force = direction * (mass * (ref_a + k_v * (v_cmd - forward)) + drag * slide_x / norm)
         torque = inertia * (ref_k * ref_a + k_w * (w_cmd - yaw_rate)) \
             + drag * lever * slide_y / norm
         r, b = p.wheel_radius, p.half_track
@@ -209,7 +261,7 @@ def rolling_path_follower(env: gym.Env[Any, Any], final_time: float | None = Non
         peak = np.abs(wheels).max()
         if peak > max_wheel_torque:
             wheels *= max_wheel_torque / peak
-        return (wheels / unwrapped.scene.max_wheel_torque).astype(np.float32)
+        return (wheels / action_torque).astype(np.float32)
 
     return policy
 
@@ -281,6 +333,7 @@ if __name__ == "__main__":
 
 
 __all__ = [
-    "BANG_BANG", "FOLLOWER", "bezier_path", "heuristic_controller", "main", "rigid_arm_bang_bang",
-    "rolling_path_follower", "speed_profile",
+    "BANG_BANG", "FOLLOWER", "PARKING_LIMITS", "bezier_path", "heuristic_controller", "main",
+    "parking_follower", "path_follower", "rigid_arm_bang_bang", "rolling_path_follower",
+    "speed_profile",
 ]

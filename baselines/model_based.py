@@ -4,7 +4,12 @@
 (env id, objective), in the same env configuration as the MPC below; it costs microseconds per
 step and is registered in ``baselines.evaluation.CONTROLLER_FACTORIES``, so every study plays it.
 ``tracking_controller`` plays ``optimal.tracking.TrackingMPC`` (its window NLPs take 10-60 s to
-build, once per row, at its first episode); ``--mpc`` adds it with the shrinking-horizon MPC.
+build, once per row, at its first episode); ``--mpc`` adds it with the shrinking-horizon MPC. On
+the robot it is supervised (``Recovering``): a time-optimal reference rides the traction limit,
+so under more friction or mass than its model the robot ends the reference at rest outside the
+goal box, where the rolling traction of the nominal model holds it still -- the LQR's gain about
+the goal at rest is zero. Past the reference's last interval the supervisor drives a rolling path
+from where the robot is into the goal (``baselines.heuristics.parking_follower``, nominal model).
 
 ``mpc_controller(env_id, objective)`` plays ``ShrinkingHorizonMPC`` around the reference of (env
 id, objective) in the env configured like the reference's open-loop replay (one env step per
@@ -22,7 +27,12 @@ import importlib.util
 from collections.abc import Callable
 from typing import Any
 
+import gymnasium as gym
+
 from baselines.evaluation import REFERENCE_NAMES, Controller
+from baselines.heuristics import parking_follower
+from mdi_envs.rollout import Policy
+from optimal.problems import make_problem, model_of
 from optimal.references import Reference, load_reference
 from optimal.replay import env_options
 
@@ -60,19 +70,61 @@ def mpc_controller(env_id: str, objective: str) -> Controller | None:
 
 
 def tracking_controller(env_id: str, objective: str) -> Controller | None:
-    """The tracking MPC along the reference of (env id, objective); None without one or CasADi."""
+    """The tracking MPC along the reference of (env id, objective), supervised on the robot.
+
+    None without a reference or CasADi.
+    """
     from optimal.tracking import TrackingMPC
 
-    return reference_controller(TRACKING, TrackingMPC, env_id, objective)
+    return reference_controller(TRACKING, TrackingMPC, env_id, objective, supervised=True)
+
+
+class Recovering:
+    """A reference tracker on the robot, then, past the reference's end, the parking follower.
+
+    For the first N steps (N the reference's intervals) the policy is ``tracker`` (a
+    ``StateFeedbackPolicy``); at step N, unless the episode has ended in the goal box, it
+    switches to ``parking_follower`` from the observed pose, with the nominal model's parameters
+    (the model the tracker has: a mismatch in the env stays unknown to both).
+
+    Args:
+        tracker: the policy along the reference (reset by ``reset``).
+        reference: the robot's reference it tracks.
+        env: an env of the played configuration (its ``dt`` and action torque scale are read).
+    """
+
+    def __init__(self, tracker: Any, reference: Reference, env: gym.Env[Any, Any]) -> None:
+        self.tracker = tracker
+        self.steps = len(reference.tau)
+        self._parameters = model_of(make_problem(reference.name))[1]
+        self._dt = float(env.unwrapped.dt)
+        self._torque = float(env.unwrapped.scene.max_wheel_torque)
+        self._step = 0
+        self.recovery: Policy | None = None
+
+    def reset(self) -> None:
+        """A new episode: the tracker's, and no recovery."""
+        self.tracker.reset()
+        self._step, self.recovery = 0, None
+
+    def __call__(self, observation: Any) -> Any:
+        """The env action at this step."""
+        if self.recovery is None and self._step >= self.steps:
+            self.recovery = parking_follower(self._parameters, self._dt, self._torque,
+                                             observation)
+        self._step += 1
+        return (self.tracker if self.recovery is None else self.recovery)(observation)
 
 
 def reference_controller(label: str, controller_class: Callable[[Reference], Any], env_id: str,
-                         objective: str, needs_casadi: bool = True) -> Controller | None:
+                         objective: str, needs_casadi: bool = True,
+                         supervised: bool = False) -> Controller | None:
     """The row ``label``: ``controller_class(reference)`` along the reference of the task.
 
     None without a reference for (env id, objective), or without CasADi when ``needs_casadi``.
     The controller is built at the row's first episode (a row not played costs nothing) and
-    serves every episode, reset at each (its built NLPs or gains stay).
+    serves every episode, reset at each (its built NLPs or gains stay). ``supervised``: on the
+    robot (a model without brakes) it is wrapped in ``Recovering``.
     """
     name = REFERENCE_NAMES.get((env_id, objective))
     if name is None or (needs_casadi and importlib.util.find_spec("casadi") is None):
@@ -80,11 +132,14 @@ def reference_controller(label: str, controller_class: Callable[[Reference], Any
     reference = load_reference(name)
     built: list[Any] = []
 
-    def make_policy(_env: Any) -> Any:
+    def make_policy(env: Any) -> Any:
         if not built:
             built.append(controller_class(reference))
-        built[0].reset()
-        return built[0]
+        policy = built[0]
+        if supervised and not policy.has_brake:
+            policy = Recovering(policy, reference, env)
+        policy.reset()
+        return policy
 
     return Controller(label, make_policy, row_env_options(reference))
 
@@ -97,5 +152,5 @@ the distillation and the datasets: the time-varying LQR (microseconds per step),
 MPC (milliseconds), the shrinking-horizon MPC (0.1-1 s)."""
 
 
-__all__ = ["EXPERTS", "LQR", "MPC", "TRACKING", "lqr_controller", "mpc_controller",
+__all__ = ["EXPERTS", "LQR", "MPC", "TRACKING", "Recovering", "lqr_controller", "mpc_controller",
            "reference_controller", "row_env_options", "tracking_controller"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from collections.abc import Callable
@@ -75,3 +76,36 @@ def test_rolling_path_follower_reaches_the_goal_without_slipping() -> None:
     terminated, info, modes = _play(env, heuristics.rolling_path_follower(env), 3, "slip_mode")
     assert terminated and info["is_success"]
     assert set(modes) == {2}  # both wheels roll throughout
+
+
+@pytest.mark.parametrize("behind", [False, True])
+def test_parking_follower_drives_into_the_goal_forward_or_in_reverse(behind: bool) -> None:
+    """Parking from rest 0.4 m before or behind the goal, the nominal model, 20 % less friction.
+
+    Heading 0.1 rad off; driven forward from before the goal, in reverse from behind it: in
+    the goal box within 2 s, both wheels rolling throughout.
+    """
+    from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
+    from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
+
+    nominal = DiffDriveParameters()
+    slippery = dataclasses.replace(nominal, wheel_friction=0.8 * nominal.wheel_friction,
+                                   stick_friction=0.8 * nominal.stick_friction)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make("mdi_envs/DiffDriveRobot-v1", reset_noise_scale=0.0, parameters=slippery)
+    env.reset(seed=0)
+    gx, gy, gphi = DIFF_DRIVE_MANEUVER.goal_pose  # heading -y: "before" is at larger y
+    env.unwrapped.set_state(np.array([gx, gy + (-0.4 if behind else 0.4), gphi + 0.1, 0.0, 0.0]),
+                            np.zeros(5))
+    obs = env.unwrapped.state.obs[0].copy()
+    policy = heuristics.parking_follower(nominal, env.unwrapped.dt,
+                                         env.unwrapped.scene.max_wheel_torque, obs)
+    speeds, done = [], False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        speeds.append(float(obs[4]))  # forward speed, body frame
+        assert info["slip_mode"] == 2
+        done = terminated or truncated
+    assert terminated and info["is_success"] and info["elapsed_time"] <= 2.0
+    assert (max(speeds) if behind else -min(speeds)) < 0.01  # one direction throughout

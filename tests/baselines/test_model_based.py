@@ -1,0 +1,50 @@
+"""``baselines.model_based``: the supervisor of the robot's reference trackers."""
+
+from __future__ import annotations
+
+import warnings
+
+import gymnasium as gym
+import numpy as np
+
+from baselines.model_based import Recovering, row_env_options
+from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
+from optimal.references import load_reference
+
+
+class _Still:
+    """A tracker that applies no torque."""
+
+    def reset(self) -> None:
+        pass
+
+    def __call__(self, _observation: np.ndarray) -> np.ndarray:
+        return np.zeros(2, np.float32)
+
+
+def test_past_the_reference_outside_the_goal_box_it_parks_the_robot() -> None:
+    """The tracker for the reference's N steps, then the parking follower into the goal box.
+
+    The tracker applies no torque, so the robot stays at rest 0.3 m before the goal for N
+    steps; the follower reaches the goal box before the episode's 2 N steps end.
+    """
+    reference = load_reference("diff_drive_time")
+    options = {**row_env_options(reference), "reset_noise_scale": 0.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make(reference.metadata["env_id"], **options)
+    policy = Recovering(_Still(), reference, env)
+    policy.reset()
+    env.reset(seed=0)
+    gx, gy, gphi = DIFF_DRIVE_MANEUVER.goal_pose
+    env.unwrapped.set_state(np.array([gx + 0.02, gy + 0.3, gphi, 0.0, 0.0]), np.zeros(5))
+    obs, steps, done = env.unwrapped.state.obs[0].copy(), 0, False
+    while not done:
+        action = policy(obs)
+        if steps < policy.steps:
+            assert policy.recovery is None and not action.any()
+        obs, _, terminated, truncated, info = env.step(action)
+        steps += 1
+        done = terminated or truncated
+    assert terminated and info["is_success"]
+    assert policy.steps < steps < 2 * policy.steps
