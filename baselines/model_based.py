@@ -45,6 +45,12 @@ TRACKING = "MPC (tracking window)"
 LQR = "LQR (time-varying)"
 """The label of the LQR rows."""
 
+STATE_INDEXED = "state-indexed"
+"""Appended to the label of a state-indexed row (``INDEX_WINDOW``)."""
+
+INDEX_WINDOW = 10
+"""The state-indexed controllers' search window [reference nodes] (``optimal.observations``)."""
+
 
 def row_env_options(reference: Reference) -> dict[str, Any]:
     """The reference's env options; time-optimal objectives get twice its steps."""
@@ -116,15 +122,27 @@ class Recovering:
         return (self.tracker if self.recovery is None else self.recovery)(observation)
 
 
+def tracking_state_controller(env_id: str, objective: str) -> Controller | None:
+    """The tracking MPC, state-indexed (``INDEX_WINDOW``) and without ``Recovering``.
+
+    None without a reference or CasADi.
+    """
+    from optimal.tracking import TrackingMPC
+
+    return reference_controller(f"{TRACKING}, {STATE_INDEXED}", TrackingMPC, env_id, objective,
+                                index_window=INDEX_WINDOW)
+
+
 def reference_controller(label: str, controller_class: Callable[[Reference], Any], env_id: str,
-                         objective: str, needs_casadi: bool = True,
-                         supervised: bool = False) -> Controller | None:
+                         objective: str, needs_casadi: bool = True, supervised: bool = False,
+                         index_window: int = 0) -> Controller | None:
     """The row ``label``: ``controller_class(reference)`` along the reference of the task.
 
     None without a reference for (env id, objective), or without CasADi when ``needs_casadi``.
     The controller is built at the row's first episode (a row not played costs nothing) and
     serves every episode, reset at each (its built NLPs or gains stay). ``supervised``: on the
-    robot (a model without brakes) it is wrapped in ``Recovering``.
+    robot (a model without brakes) it is wrapped in ``Recovering``. ``index_window``: its
+    ``StateFeedbackPolicy.index_window`` (0: time-indexed).
     """
     name = REFERENCE_NAMES.get((env_id, objective))
     if name is None or (needs_casadi and importlib.util.find_spec("casadi") is None):
@@ -135,6 +153,7 @@ def reference_controller(label: str, controller_class: Callable[[Reference], Any
     def make_policy(env: Any) -> Any:
         if not built:
             built.append(controller_class(reference))
+            built[0].index_window = index_window
         policy = built[0]
         if supervised and not policy.has_brake:
             policy = Recovering(policy, reference, env)
@@ -145,12 +164,14 @@ def reference_controller(label: str, controller_class: Callable[[Reference], Any
 
 
 EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
-    "lqr": lqr_controller, "tracking": tracking_controller, "mpc": mpc_controller,
+    "lqr": lqr_controller, "tracking": tracking_controller,
+    "tracking-state": tracking_state_controller, "mpc": mpc_controller,
 }  # fmt: skip
 """Feedback expert name -> its ``ControllerFactory`` (``baselines.evaluation``), the experts of
 the distillation and the datasets: the time-varying LQR (microseconds per step), the tracking
-MPC (milliseconds), the shrinking-horizon MPC (0.1-1 s)."""
+MPC (milliseconds; time- or state-indexed), the shrinking-horizon MPC (0.1-1 s)."""
 
 
-__all__ = ["EXPERTS", "LQR", "MPC", "TRACKING", "Recovering", "lqr_controller", "mpc_controller",
-           "reference_controller", "row_env_options", "tracking_controller"]
+__all__ = ["EXPERTS", "INDEX_WINDOW", "LQR", "MPC", "STATE_INDEXED", "TRACKING", "Recovering",
+           "lqr_controller", "mpc_controller", "reference_controller", "row_env_options",
+           "tracking_controller", "tracking_state_controller"]

@@ -130,6 +130,8 @@ class TimeVaryingLQR(StateFeedbackPolicy):
         gains: (N, m, 2n) K_k. hold_gain: (m, 2n) the gain past the reference.
         cost_to_go: (N+1, 2n, 2n) P_k. hold_cost_to_go: (2n, 2n) P past the reference.
         state_weight: (2n, 2n) Q. input_weight: (m, m) R.
+        node_states: (N+1, 2n) the reference's states; node_weight: (2n,) the diagonal of Q
+            (``StateFeedbackPolicy``).
         compute_times: CPU time [s] of each control step of this episode.
     """
 
@@ -159,6 +161,7 @@ class TimeVaryingLQR(StateFeedbackPolicy):
                                   np.repeat(b[None], HOLD_STEPS, 0), Q, R, terminal_weight * Q)
         self.hold_gain, self.hold_cost_to_go = hold[0], hold_cost[0]
         self.state_weight, self.input_weight = Q, R
+        self.node_states, self.node_weight = self._x, np.diag(Q).copy()
         self._goal = np.concatenate([reference.q[-1], np.zeros(model.NUM_DOFS)])
         self.compute_times: list[float] = []
 

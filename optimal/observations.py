@@ -5,7 +5,9 @@ the goal offset and heading error and its velocity in the body frame; neither ca
 robot's wheel angles, on which no dynamics depend. ``decode_observation`` inverts that against
 a predicted q (the controller's plan or reference): angles are unwrapped to the branch nearest
 the prediction and the wheel angles are taken from it. ``StateFeedbackPolicy`` is the env policy
-of a controller that acts on (q, u): decode, control, encode the action, time the call.
+of a controller that acts on (q, u): decode, control, encode the action, time the call; its
+step is the number of calls this episode (time-indexed) or the reference node nearest the
+measured state (state-indexed, ``index_window``).
 """
 
 from __future__ import annotations
@@ -52,15 +54,28 @@ def decode_observation(observation: FloatArray, predicted_q: FloatArray,
 class StateFeedbackPolicy:
     """An env policy (default Box action space) from a state feedback ``control(step, q, u)``.
 
-    Subclasses set ``has_brake``, ``torque_bound`` [N m] and ``compute_times`` (reset per
-    episode) and define ``control`` and ``predicted_q``; a call decodes the observation against
-    ``predicted_q(step)``, applies ``control`` at the step (the number of calls this episode),
-    encodes the torques and brake bounds as the Box action and records its CPU time [s].
+    Subclasses set ``has_brake``, ``torque_bound`` [N m], ``compute_times`` (reset per
+    episode), ``node_states`` (N + 1, 2n) the reference's states (q, u) and ``node_weight``
+    (2n,) a weight per state component, and define ``control`` and ``predicted_q``. A call
+    decodes the observation against ``predicted_q`` at the last step, chooses the step, applies
+    ``control`` at it, encodes the torques and brake bounds as the Box action and records its
+    CPU time [s].
+
+    The step is the number of calls this episode (time-indexed) when ``index_window`` is 0;
+    otherwise (state-indexed) it is ``nearest_node`` of the measured state, searched from the
+    last call's step (0 at the first call) over the ``index_window`` nodes after it, so it never
+    goes back. A time-indexed policy that lags the reference acts for a later phase of it; a
+    state-indexed one acts for the phase it is in, so its action is a function of the state
+    and of the last step only.
     """
 
     has_brake: bool
     torque_bound: float
     compute_times: list[float]
+    node_states: FloatArray
+    node_weight: FloatArray
+    index_window: int = 0
+    _index: int = 0
 
     def predicted_q(self, step: int) -> FloatArray:
         """(n,) the q expected at env step ``step`` (angles unwrapped near it)."""
@@ -70,11 +85,24 @@ class StateFeedbackPolicy:
         """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""
         raise NotImplementedError
 
+    def nearest_node(self, q: FloatArray, u: FloatArray, first: int) -> int:
+        """The node k in ``first`` ... ``first + index_window`` nearest (q, u).
+
+        Distance: sum_i node_weight_i (x_i - node_states[k, i])^2; the first node on a tie.
+        """
+        stop = min(first + self.index_window + 1, len(self.node_states))
+        error = self.node_states[first:stop] - np.concatenate([q, u])
+        return first + int(np.argmin(np.square(error) @ self.node_weight))
+
     def __call__(self, observation: FloatArray) -> FloatArray:
         """The env action for an observation of the reference's env."""
         clock = time.process_time()
         step = len(self.compute_times)
+        if self.index_window:
+            step = self._index if step else 0
         q, u = decode_observation(observation, self.predicted_q(step), self.has_brake)
+        if self.index_window:
+            step = self._index = self.nearest_node(q, u, step)
         tau, brake = self.control(step, q, u)
         action = [tau / self.torque_bound]
         if self.has_brake:

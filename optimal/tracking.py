@@ -81,7 +81,8 @@ class TrackingMPC(StateFeedbackPolicy):
             ``MAX_ITERATIONS``.
 
     Attributes:
-        lqr: the ``TimeVaryingLQR`` whose weights and fallback control it uses.
+        lqr: the ``TimeVaryingLQR`` whose weights, fallback control and ``node_states``,
+            ``node_weight`` (``StateFeedbackPolicy``) it uses.
         compute_times: CPU time [s] of each control step of this episode.
         fallbacks: steps of this episode at which IPOPT failed and the LQR's control was applied.
         iterations: IPOPT's iterations per step of this episode.
@@ -93,6 +94,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self.horizon = int(horizon or HORIZON.get(reference.name, DEFAULT_HORIZON))
         self.max_iterations = int(max_iterations)
         self.lqr = TimeVaryingLQR(reference)
+        self.node_states, self.node_weight = self.lqr.node_states, self.lqr.node_weight
         self.base = make_problem(reference.name, len(reference.tau))
         self.has_brake = bool(self.base.model.NUM_BRAKES)
         self.torque_bound = float(reference.metadata["torque_bound"])

@@ -73,3 +73,28 @@ def test_from_the_reference_start_the_lqr_replays_the_reference() -> None:
         tau, brake = controller.control(k, reference.q[k], reference.u[k])
         np.testing.assert_allclose(tau, reference.tau[k], atol=1e-12)
         np.testing.assert_array_equal(brake, reference.brake_bound[k])
+
+
+def test_a_state_indexed_lqr_finds_the_reference_node_of_the_state() -> None:
+    """The state-indexed step: node k's own state gives k, and the nominal replay its step count.
+
+    Searched from ``first`` on, the index is never behind ``first``.
+    """
+    reference = load_reference("manipulator_time")
+    controller = TimeVaryingLQR(reference)
+    controller.index_window = 10
+    for k in range(0, len(reference.tau) + 1, 7):
+        for first in (max(k - 10, 0), k):
+            assert controller.nearest_node(reference.q[k], reference.u[k], first) == k
+        assert controller.nearest_node(reference.q[k], reference.u[k], k + 1) > k
+    indices = []
+
+    def policy(observation: np.ndarray) -> np.ndarray:
+        action = controller(observation)
+        indices.append(controller._index)
+        return action
+
+    info = _play(policy, reference, 0, 0.0)
+    assert info["is_success"]  # within the goal's tolerance a few steps before the last node
+    assert len(indices) > len(reference.tau) - 5
+    np.testing.assert_array_equal(indices, np.arange(len(indices)))
