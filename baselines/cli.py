@@ -104,7 +104,8 @@ def _study_arguments(parser: argparse.ArgumentParser, scales: list[float],
     parser.add_argument("--mpc", action="store_true",
                         help="also play the MPC rows around the reference: the shrinking-horizon "
                         "MPC (optimal.mpc; 0.1-1 s of compute per env step) and the tracking MPC "
-                        "(optimal.tracking; milliseconds); both need CasADi")
+                        "(optimal.tracking; milliseconds), time- and state-indexed; they need "
+                        "CasADi")
     parser.add_argument("--controllers", nargs="+", default=None, metavar="LABEL",
                         help="play only these rows (labels as in the table, e.g. PPO HybridPPO "
                         "'MPC (shrinking horizon)') and merge them into the study already in "
@@ -203,9 +204,11 @@ def _studies(args: argparse.Namespace, prefix: str, nominal: bool,
     for env_id, objective in jobs:
         extra = []
         if args.mpc:
-            from baselines.model_based import mpc_controller, tracking_controller
+            from baselines.model_based import EXPERTS, lqr_controller
 
-            for factory in (mpc_controller, tracking_controller):
+            for factory in EXPERTS.values():  # the LQR is a registered row
+                if factory is lqr_controller:
+                    continue
                 controller = factory(env_id, objective)
                 if controller is None:
                     raise SystemExit(f"{prefix}: --mpc needs CasADi (pip install "
