@@ -1,18 +1,18 @@
 """Model-based controllers in real time (``mdi-envs bench control``): compute, success, cost.
 
-Each controller row of ``baselines.model_based`` plays every optimal reference's task (``TASKS``,
-in the env id of its metadata) from perturbed starts (``reset(seed=s)`` at each
-``SCALES`` half-width) in the env configured like the comparison. The compute of each control
-step is CPU time (``time.process_time`` around the policy call), so other processes on the
-machine do not inflate it; the real-time factor is that time over the control period (the env's
-dt, the reference's h): at most 1 means the controller keeps up with the plant. Reported per row:
-the real-time factor's median, 95th percentile and worst over all steps of all episodes; the
-success rate; the time (time tasks) or effort (effort task) over the reference's, mean over the
-successes. The shrinking-horizon MPC takes seconds per step: it plays the first ``SLOW_STEPS``
-steps of ``SLOW_STARTS`` starts per scale (compute only); ``--quick`` plays the LQR only.
-``--controllers`` plays some rows and keeps the others of an existing ``control.json`` (each
-record carries its date). With the tracking MPC, ``memory_growth`` measures the memory over
-``MEMORY_STEPS`` steps without a plan. Writes ``control.json`` and ``control.png``.
+Each controller of ``baselines.model_based.EXPERTS`` (a row keyed by its name there) plays every
+optimal reference's task (``TASKS``, in the env id of its metadata) from perturbed starts
+(``reset(seed=s)`` at each ``SCALES`` half-width) in the env configured like the comparison. The
+compute of each control step is CPU time (``time.process_time`` around the policy call), so other
+processes on the machine do not inflate it; the real-time factor is that time over the control
+period (the env's dt, the reference's h): at most 1 means the controller keeps up. Reported per row:
+the real-time factor's median, 95th percentile and worst over all steps of all episodes; the success
+rate; the time (time tasks) or effort (effort task) over the reference's, mean over the successes.
+The shrinking-horizon MPC takes seconds per step: it plays the first ``SLOW_STEPS`` steps of
+``SLOW_STARTS`` starts per scale (compute only); ``--quick`` plays the LQR only. ``--controllers``
+plays some rows and keeps the others of an existing ``control.json`` (each record carries its date).
+With the tracking MPC, ``memory_growth`` measures the memory over ``MEMORY_STEPS`` steps without a
+plan. Writes ``control.json`` and ``control.png``.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import resource
 import sys
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -30,24 +30,15 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.evaluation import REFERENCE_NAMES, Controller, reference_effort
-from baselines.model_based import (
-    lqr_controller,
-    mpc_controller,
-    row_env_options,
-    tracking_controller,
-)
+from baselines.model_based import EXPERTS, row_env_options
 from benchmarks import report
 from benchmarks.timing import VERSIONED_PACKAGES, Progress, arguments, finish, machine_info
 from optimal.references import load_reference
 
-CONTROLLERS: dict[str, Callable[[str, str], Controller | None]] = {
-    "lqr": lqr_controller, "tracking": tracking_controller, "shrinking": mpc_controller}
-"""Row key -> the ``ControllerFactory`` it plays."""
-
 TASKS = tuple(dict.fromkeys(REFERENCE_NAMES.values()))
 """The references, each played in the env it was computed for (its metadata's env id)."""
 
-SLOW = ("shrinking",)
+SLOW = ("mpc",)
 """Rows that play ``SLOW_STARTS`` starts."""
 
 QUICK_ROWS = ("lqr",)
@@ -102,7 +93,7 @@ def measure(key: str, env_id: str, objective: str, starts: int, progress: Progre
     ``max_steps``: play only the first steps of each episode (compute only; success and cost
     are then None).
     """
-    controller = CONTROLLERS[key](env_id, objective)
+    controller = EXPERTS[key](env_id, objective)
     if controller is None:
         return []
     reference = load_reference(REFERENCE_NAMES[(env_id, objective)])
@@ -219,7 +210,7 @@ def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
     kept = []  # read at the end: a run of other rows may have written meanwhile
     if path.exists() and not quick:
         kept = [r for r in json.loads(path.read_text()).get("records", [])
-                if r["controller"] not in keys]
+                if r["controller"] not in keys and r["controller"] in EXPERTS]
     record["records"] = kept + records
     record["targets"] = targets(record["records"])
     if "tracking" in keys:
@@ -246,9 +237,9 @@ def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point."""
     args = arguments(__doc__, argv, ("--controllers", {
-        "nargs": "+", "choices": list(CONTROLLERS), "default": None,
+        "nargs": "+", "choices": list(EXPERTS), "default": None,
         "help": "rows to play (default: all; --quick: QUICK_ROWS)"}))
-    keys = args.controllers or [k for k in CONTROLLERS if not args.quick or k in QUICK_ROWS]
+    keys = args.controllers or [k for k in EXPERTS if not args.quick or k in QUICK_ROWS]
     args.output.mkdir(parents=True, exist_ok=True)
     print(run(args.quick, args.output, keys))
     return 0
