@@ -15,6 +15,8 @@
   before the fixed horizon. A tracking law (Kanayama et al. 1990) turns the pose error into
   speed and yaw-rate commands, a velocity loop with acceleration feedforward into wheel
   torques, clipped to ``max_wheel_torque`` (below the traction limit: no slip when it holds).
+  ``path_follower`` is that law along any path; ``parking_follower`` along one segment from the
+  robot's pose into the goal, forward or in reverse (``baselines.model_based.Recovering``).
 
 ``heuristic_controller(env_id, objective)`` returns the floor of a mission env as a comparison
 ``Controller``; ``python -m baselines.heuristics`` plays each from the nominal start and from
