@@ -177,12 +177,15 @@ def _studies(args: argparse.Namespace, prefix: str, nominal: bool,
              conditions: Callable[[str], list[Condition]]) -> list[Study]:  # fmt: skip
     """Play each env x objective of ``args`` and write ``{prefix}_ENV_OBJECTIVE.json``; the studies.
 
-    With ``--controllers`` the study merges into the one in the folder. ``nominal`` (the
-    comparison): also the nominal starts, and bootstrap intervals in the aggregates.
+    With ``--controllers`` the study merges into the one in the folder, whose trained rows stay
+    while their algorithm has policies in ``--trained`` or a shipped folder (``TRAINED_DIR``,
+    ``DISTILLED_DIR``). ``nominal`` (the comparison): also the nominal starts, and bootstrap
+    intervals in the aggregates.
     """
     import sys
 
     from baselines.evaluation import (
+        DISTILLED_DIR,
         REFERENCE_NAMES,
         TRAINED_DIR,
         aggregate,
@@ -224,7 +227,8 @@ def _studies(args: argparse.Namespace, prefix: str, nominal: bool,
             raise SystemExit(f"{prefix}: {error}") from error
         path = args.output / f"{prefix}_{study.name}.json"
         if args.controllers is not None and path.exists():
-            shipped = shipped_algorithms(env_id, objective, trained_dir)
+            shipped = set().union(*(shipped_algorithms(env_id, objective, folder)
+                                    for folder in (trained_dir, TRAINED_DIR, DISTILLED_DIR)))
             study = merge(read_study(path), study, shipped)
         study = aggregate(study, args.bootstrap_reps if nominal else 0)
         studies.append(study)

@@ -62,7 +62,7 @@ import torch as th
 from stable_baselines3.common.torch_layers import FlattenExtractor
 
 from baselines.datasets import TASKS, dataset_id
-from baselines.evaluation import OBJECTIVES, Controller, play
+from baselines.evaluation import DISTILLED_DIR, OBJECTIVES, Controller, play
 from baselines.model_based import EXPERTS
 from mdi_envs.provenance import git_commit
 
@@ -75,7 +75,7 @@ FIRST_TRAINING_SEED = 1_000_000
 ALGO = "DAgger"
 """The ``algo`` of the records: the row label of the distilled policies."""
 
-DEFAULT_OUTPUT = Path(__file__).parent / "distilled"
+DEFAULT_OUTPUT = DISTILLED_DIR
 """Where ``mdi-envs distill`` writes by default (``--trained`` of ``mdi-envs compare``)."""
 
 

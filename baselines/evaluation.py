@@ -60,6 +60,9 @@ from optimal.replay import env_actions, env_options
 TRAINED_DIR = Path(__file__).parent / "trained"
 """Where the shipped policies live: ``STEM.zip`` + ``STEM.json`` (see ``baselines.train``)."""
 
+DISTILLED_DIR = Path(__file__).parent / "distilled"
+"""Where the shipped distilled policies live (``baselines.distill``), in the same format."""
+
 REFERENCE_NAMES = {
     (MANIPULATOR, "time"): "manipulator_time",
     (DIFF_DRIVE, "time"): "diff_drive_time",
@@ -491,7 +494,8 @@ def merge(old: Study, new: Study, shipped: Collection[str] | None = None) -> Stu
 __all__ = [
     "CONTROLLER_FACTORIES", "DIFF_DRIVE", "DIFF_DRIVE_EFFORT_V1", "DIFF_DRIVE_V1", "MANIPULATOR",
     "MANIPULATOR_V1", "MISMATCHES", "OBJECTIVES",
-    "REFERENCE_NAMES", "SCALES", "SCHEDULE_KEYS", "SCORES", "TRAINED_DIR", "Controller",
+    "REFERENCE_NAMES", "SCALES", "SCHEDULE_KEYS", "SCORES", "TRAINED_DIR", "DISTILLED_DIR",
+    "Controller",
     "ControllerFactory", "LoggedEpisode", "aggregate", "append_log", "controller_rows",
     "evaluate", "group_by_algorithm", "load_policy", "merge", "optimal_controller",
     "play", "read_log", "reference_controller", "reference_effort", "register_controller",
