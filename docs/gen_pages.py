@@ -337,8 +337,9 @@ def robustness_page() -> None:
     studies = [read_study(p) for p in sorted(folder.glob("robustness_*.json"))]
     lines = ["# Robustness", "",
              "Generated from `baselines/robustness/robustness_*.json` (written by "
-             "`mdi-envs robustness all --output baselines/robustness`; every episode "
-             "is in `episodes.jsonl`). Each cell: success over 20 starts per run, and in "
+             "`mdi-envs robustness all --output baselines/robustness`, the distilled rows of "
+             "the v1 studies with `--trained baselines/distilled --controllers DAgger`; every "
+             "episode is in `episodes.jsonl`). Each cell: success over 20 starts per run, and in "
              "brackets the time (or effort) over the optimum, over the successes.", "",
              robustness_table(studies), ""]
     for png in sorted(folder.glob("*.png")):
