@@ -56,6 +56,27 @@ DEFAULT_OBJECTIVES = {MANIPULATOR: "time", DIFF_DRIVE: "time", MANIPULATOR_V1: "
 """The trainable env ids and the objective used when none is given: a v0 id takes it as an env
 argument (the manipulator has only "time"), a v1 id has one objective, its own."""
 
+def parse_schedule(name: str, value: float | str) -> tuple[float, bool]:
+    """(initial value, decays linearly to 0) of SB3 argument ``name``.
+
+    ``value`` is a number or rl-zoo3's schedule string ``"lin_X"``: X times the fraction of
+    training that remains.
+
+    Raises:
+        ValueError: a string that is not ``lin_<number>``.
+    """
+    if not isinstance(value, str):
+        return float(value), False
+    kind, _, initial = value.partition("_")
+    if kind == "lin":
+        try:
+            return float(initial), True
+        except ValueError:
+            pass
+    raise ValueError(f"{name}: {value!r} is not a schedule rl-zoo3 reads; "
+                     "write lin_<initial value>")
+
+
 _NORMALIZE_REWARD = {"norm_obs": False, "norm_reward": True}
 """rl-zoo3's ``normalize`` value of the entries with ``normalize_reward``."""
 
@@ -150,5 +171,5 @@ __all__ = [
     "ALGORITHMS", "ALGORITHM_CLASSES", "DEFAULT_SEED", "DEFAULT_OBJECTIVES", "DIFF_DRIVE",
     "DIFF_DRIVE_EFFORT_V1", "DIFF_DRIVE_V1", "HYPERPARAMS_DIR", "MANIPULATOR", "MANIPULATOR_V1",
     "canonical_algorithm", "entry_from_zoo", "get_hyperparameters", "hyperparameter_file",
-    "hyperparameter_table",
+    "hyperparameter_table", "parse_schedule",
 ]

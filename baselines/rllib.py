@@ -94,10 +94,12 @@ def ppo_config(env_id: str, objective: str | None = None, *, num_env_runners: in
     """
     from ray.rllib.algorithms.ppo import PPOConfig
 
-    from baselines.hyperparameters import get_hyperparameters
+    from baselines.hyperparameters import get_hyperparameters, parse_schedule
 
     entry = get_hyperparameters(env_id, "PPO", objective)
     sb3 = entry["algo_kwargs"]
+    lr, decays = parse_schedule("learning_rate", sb3["learning_rate"])
+    schedule = [[0, lr], [entry["total_timesteps"], 0.0]] if decays else lr  # RLlib's piecewise
     copies = entry["num_envs"] if num_envs_per_env_runner is None else num_envs_per_env_runner
     batch = sb3["n_steps"] * entry["num_envs"] if train_batch_size is None else train_batch_size
     return (
@@ -105,7 +107,7 @@ def ppo_config(env_id: str, objective: str | None = None, *, num_env_runners: in
         .environment(register_env(env_id), env_config=entry["env_kwargs"])
         .env_runners(num_env_runners=num_env_runners, num_envs_per_env_runner=copies)
         .training(gamma=sb3["gamma"], lambda_=sb3["gae_lambda"], clip_param=sb3["clip_range"],
-                  lr=sb3["learning_rate"], entropy_coeff=sb3["ent_coef"],
+                  lr=schedule, entropy_coeff=sb3["ent_coef"],
                   grad_clip=sb3["max_grad_norm"], use_kl_loss=False,
                   train_batch_size_per_learner=batch,
                   minibatch_size=sb3["batch_size"] if minibatch_size is None else minibatch_size,

@@ -454,11 +454,20 @@ def best_arguments(name: str, url: str = DEFAULT_STORAGE) -> dict[str, Any]:
     return SAMPLERS[SEARCHES[name].algo](optuna.trial.FixedTrial(study.best_trial.params))
 
 
+ANNEALED = ("PPO", "HybridPPO")
+"""Algorithms whose searched learning rate is written as rl-zoo3's ``lin_X``, decaying linearly to
+0 over the run's budget (8-20x a trial's): a trial ranks how fast a setting learns, and at a
+constant rate a fast-learning setting can keep swinging between success and failure to the end
+of a long run (docs/guide/baselines.md shows one)."""
+
+
 def write_yaml(name: str, url: str = DEFAULT_STORAGE, directory: Path | None = None) -> Path:
     """Write the best trial's arguments into the study's entry of its rl-zoo3 file.
 
     The entry keeps its copies, budget, normalization and env arguments; the other entries
-    and the file's comments are left as they are. Returns the file's path.
+    and the file's comments are left as they are. For the algorithms of ``ANNEALED`` the
+    searched learning rate is the start of rl-zoo3's linear schedule ``lin_X``. Returns the
+    file's path.
 
     Raises:
         KeyError: the file has no entry for the study's env id.
@@ -478,6 +487,8 @@ def write_yaml(name: str, url: str = DEFAULT_STORAGE, directory: Path | None = N
     if search.env_id not in entries:
         raise KeyError(f"{path.name} has no entry {search.env_id}")
     entry = {**entries[search.env_id], **best_arguments(name, url)}
+    if search.algo in ANNEALED:
+        entry["learning_rate"] = f"lin_{entry['learning_rate']}"
     block = yaml.safe_dump({search.env_id: entry}, sort_keys=False, default_flow_style=None)
     pattern = re.compile(rf"^{re.escape(search.env_id)}:.*?(?=^\S|\Z)", re.M | re.S)
     path.write_text(pattern.sub(lambda _: block + "\n", text, count=1).rstrip("\n") + "\n")
@@ -512,7 +523,7 @@ if __name__ == "__main__":
 
 
 __all__ = [
-    "DEFAULT_STORAGE", "NUM_STARTS", "SEARCHES", "START_NOISE", "Search", "best_arguments",
-    "evaluate_starts", "load_study", "make_objective", "optimal_cost", "plot", "run", "sample_ppo",
-    "sample_sac", "score", "summary", "train_and_score", "write_yaml",
+    "ANNEALED", "DEFAULT_STORAGE", "NUM_STARTS", "SEARCHES", "START_NOISE", "Search",
+    "best_arguments", "evaluate_starts", "load_study", "make_objective", "optimal_cost", "plot",
+    "run", "sample_ppo", "sample_sac", "score", "summary", "train_and_score", "write_yaml",
 ]

@@ -45,7 +45,12 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 import mdi_envs
-from baselines.hyperparameters import ALGORITHM_CLASSES, canonical_algorithm, get_hyperparameters
+from baselines.hyperparameters import (
+    ALGORITHM_CLASSES,
+    canonical_algorithm,
+    get_hyperparameters,
+    parse_schedule,
+)
 from mdi_envs.provenance import git_commit
 
 EPISODE_COLUMNS = ("timesteps", "return", "length", "is_success", "elapsed_time", "effort")
@@ -154,6 +159,27 @@ def read_training(path: Path) -> TrainingRecord:
 def run_name(env_id: str, objective: str, algo: str, seed: int) -> str:
     """The file stem of a run, e.g. ``BlockableManipulator-v0_time_ppo_seed0``."""
     return f"{env_id.split('/')[-1]}_{objective}_{algo.lower()}_seed{seed}"
+
+
+SCHEDULED = ("learning_rate", "clip_range", "clip_range_vf")
+"""The SB3 arguments that may be an rl-zoo3 schedule string."""
+
+
+def with_schedules(algo_kwargs: dict[str, Any]) -> dict[str, Any]:
+    """``algo_kwargs`` with rl-zoo3's schedule strings made SB3 schedules, as rl-zoo3 reads them.
+
+    ``"lin_X"`` (``baselines.hyperparameters.parse_schedule``) becomes
+    ``stable_baselines3.common.utils.LinearSchedule(X, 0, 1)``: X at the start of training, 0 at
+    its end. Numbers stay as they are.
+    """
+    from stable_baselines3.common.utils import LinearSchedule
+
+    resolved = dict(algo_kwargs)
+    for key in SCHEDULED:
+        if isinstance(resolved.get(key), str):
+            start, _ = parse_schedule(key, resolved[key])
+            resolved[key] = LinearSchedule(start, 0.0, 1.0)
+    return resolved
 
 
 def algorithm_class(algo: str) -> Any:
@@ -266,7 +292,7 @@ def train(
     model_class = algorithm_class(algo)
     model = model_class("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose,
                         tensorboard_log=str(output / "tensorboard"),
-                        **copy.deepcopy(algo_kwargs))  # fmt: skip
+                        **with_schedules(copy.deepcopy(algo_kwargs)))  # fmt: skip
     log = EpisodeLog()
     start = time.perf_counter()
     model.learn(total_timesteps=total_timesteps, callback=log, tb_log_name=stem,
@@ -360,5 +386,5 @@ def versions() -> dict[str, str]:
 __all__ = [
     "EpisodeLog", "PolicyEvaluation", "RecentEpisodes", "TrainingRecord", "algorithm_class",
     "check_single_env", "evaluate", "load_trained", "read_training", "run_name", "train",
-    "write_logs",
+    "with_schedules", "write_logs",
 ]

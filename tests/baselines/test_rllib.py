@@ -34,3 +34,16 @@ def test_one_rllib_ppo_iteration_on_the_registered_id() -> None:
     finally:
         ray.shutdown()
     assert row["env_steps"] >= 256
+
+
+def test_a_linear_learning_rate_becomes_rllibs_piecewise_schedule() -> None:
+    pytest.importorskip("ray.rllib", reason="RLlib is in the rllib extra")
+    from baselines.hyperparameters import get_hyperparameters
+    from baselines.rllib import ppo_config
+
+    robot = "mdi_envs/DiffDriveRobot-v1"
+    entry = get_hyperparameters(robot, "PPO")
+    initial = float(entry["algo_kwargs"]["learning_rate"].removeprefix("lin_"))
+    assert ppo_config(robot).lr == [[0, initial], [entry["total_timesteps"], 0.0]]
+    assert ppo_config(MANIPULATOR).lr == get_hyperparameters(MANIPULATOR, "PPO")[
+        "algo_kwargs"]["learning_rate"]

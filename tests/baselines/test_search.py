@@ -97,7 +97,7 @@ def test_study_resumes_records_its_trials_and_writes_the_best_into_yaml(tmp_path
     path = search.write_yaml(name, url, directory=tmp_path)
     after = yaml.safe_load(path.read_text())
     entry = after["mdi_envs/DiffDriveRobot-v1"]
-    assert entry["learning_rate"] == study.best_trial.params["learning_rate"]
+    assert entry["learning_rate"] == f"lin_{study.best_trial.params['learning_rate']}"
     assert entry["n_steps"] == 64 and entry["n_timesteps"] == 4_000_000
     assert {k: v for k, v in after.items() if k != "mdi_envs/DiffDriveRobot-v1"} == {
         k: v for k, v in before.items() if k != "mdi_envs/DiffDriveRobot-v1"}

@@ -132,3 +132,18 @@ def test_every_shipped_training_record_reads_back(tmp_path: Path) -> None:
     (tmp_path / "broken.json").write_text(json.dumps(broken))
     with pytest.raises(ValidationError, match="evaluation.seed"):
         read_training(tmp_path / "broken.json")
+
+
+def test_schedule_strings_are_read_as_rl_zoo3_reads_them() -> None:
+    from baselines.hyperparameters import parse_schedule
+    from baselines.train import with_schedules
+
+    assert parse_schedule("learning_rate", 3e-4) == (3e-4, False)
+    assert parse_schedule("learning_rate", "lin_0.002") == (0.002, True)
+    resolved = with_schedules({"learning_rate": "lin_0.002", "clip_range": 0.2, "gamma": 0.99})
+    assert [resolved["learning_rate"](remaining) for remaining in (1.0, 0.5, 0.0)] == pytest.approx(
+        [0.002, 0.001, 0.0])
+    assert resolved["clip_range"] == 0.2 and resolved["gamma"] == 0.99
+    for bad in ("exp_0.002", "lin_fast"):
+        with pytest.raises(ValueError, match="learning_rate: .* write lin_<initial value>"):
+            with_schedules({"learning_rate": bad})
