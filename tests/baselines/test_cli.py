@@ -60,14 +60,16 @@ def test_compare_plays_two_scales_and_merges_a_rerun(tmp_path: Path,
     optimal = study.row(OPTIMAL)
     assert [run.condition.scale for run in optimal.runs] == [0.01, 0.1]
     assert all(run.commit and run.nominal.trajectory for run in optimal.runs)
-    # a row rerun merges: the others stay; a trained row whose policies are gone is dropped
+    # a row rerun merges: the others stay, and so does a trained row whose algorithm is
+    # shipped (SAC in baselines/trained, not in --trained); one whose policies are gone is dropped
     kept = dataclasses.replace(optimal, label="kept row")
-    withdrawn = dataclasses.replace(optimal, label="SAC", trained=True)
-    write_study(dataclasses.replace(study, rows=[kept, optimal, withdrawn]), path)
+    shipped = dataclasses.replace(optimal, label="SAC", trained=True)
+    withdrawn = dataclasses.replace(optimal, label="TQC", trained=True)
+    write_study(dataclasses.replace(study, rows=[kept, optimal, shipped, withdrawn]), path)
     assert run(*common, "--scales", "0.3", "--controllers", OPTIMAL) == 0
     merged = read_study(path)
     assert [c.scale for c in merged.conditions] == [0.01, 0.1, 0.3]
-    assert [row.label for row in merged.rows] == ["kept row", OPTIMAL]
+    assert [row.label for row in merged.rows] == ["kept row", OPTIMAL, "SAC"]
     assert merged.rows[0] == kept and len(merged.row(OPTIMAL).runs) == 3
     assert "| kept row " in (out / "compare.md").read_text()
     with pytest.raises(SystemExit, match="no controller 'PP0'"):
