@@ -85,6 +85,3 @@ def run_bench(args: argparse.Namespace) -> int:
         print(f"bench: failed: {', '.join(failures)}", file=sys.stderr)
         return 1
     return 0
-
-
-__all__ = ["BENCHMARKS", "DEFAULT_OUTPUT", "add_bench_parser", "run_bench"]

@@ -207,11 +207,10 @@ def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
             meta = load_reference(name).metadata
             records += measure(key, meta["env_id"], meta["cost_kind"], starts, progress,
                                SLOW_STEPS if key in SLOW else None)
-    kept = []  # read at the end: a run of other rows may have written meanwhile
-    if path.exists() and not quick:
-        kept = [r for r in json.loads(path.read_text()).get("records", [])
-                if r["controller"] not in keys and r["controller"] in EXPERTS]
-    record["records"] = kept + records
+    # read at the end: a run of other rows may have written meanwhile
+    previous = json.loads(path.read_text()) if path.exists() and not quick else {}
+    record["records"] = [r for r in previous.get("records", [])
+                         if r["controller"] not in keys and r["controller"] in EXPERTS] + records
     record["targets"] = targets(record["records"])
     if "tracking" in keys:
         record["memory"] = memory_growth(QUICK_MEMORY_STEPS if quick else MEMORY_STEPS, progress)
@@ -219,8 +218,7 @@ def run(quick: bool, output: Path, keys: Sequence[str]) -> str:
             f"peak RSS growth over {record['memory']['steps']} steps without a plan",
             "≤", TARGET_GROWTH_MB, "MB", record["memory"]["growth_mb"],
             "tracking MPC, manipulator"))
-    elif path.exists() and not quick:
-        previous = json.loads(path.read_text())
+    elif previous:
         record["memory"] = previous.get("memory")
         record["targets"] += [t for t in previous.get("targets", []) if "RSS" in t["target"]]
     finish(record, progress.elapsed)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -103,9 +104,9 @@ QUICK = EngineConfig(
 TARGETS_US = {"manipulator_batched": 0.1, "manipulator_python": 1.0, "diff_drive": 2.0}
 
 
-def _first_batch(st: MoreauJeanStepper, case: ModelCase) -> None:
-    """One tiny ``step_batch`` call (compiles it)."""
-    BatchedCall(st, batch_arrays(case, 2), 1)()
+def _first_batch_s(st: MoreauJeanStepper, case: ModelCase) -> float:
+    """Seconds of one tiny ``step_batch`` call (it compiles)."""
+    return timing.seconds(lambda: BatchedCall(st, batch_arrays(case, 2), 1)())
 
 
 def compile_steppers(cases: list[ModelCase], log: Progress
@@ -116,8 +117,8 @@ def compile_steppers(cases: list[ModelCase], log: Progress
         log(f"compiling {case.label} (first step, then first step_batch) ...")
         st = steppers[case.label] = stepper(case)
         arrays = case.scenes[0].arrays()
-        step_s = timing.seconds(lambda st=st, arrays=arrays: st.step(*arrays))
-        batch_s = timing.seconds(lambda st=st, case=case: _first_batch(st, case))
+        step_s = timing.seconds(lambda: st.step(*arrays))  # noqa: B023  (called at once)
+        batch_s = _first_batch_s(st, case)
         records.append({"stepper": f"{case.label} (default shortcuts)", "step_s": step_s,
                         "step_batch_s": batch_s})
         log(f"  {case.label}: first step {step_s:.1f} s, first step_batch {batch_s:.1f} s")
@@ -180,22 +181,14 @@ def _batched_entry(st: MoreauJeanStepper, initial: tuple, target_s: float,
                    min_substeps: int = 1) -> BatchedCall:
     """A ``BatchedCall`` of at least ``min_substeps`` substeps, lasting about ``target_s``+."""
     call = BatchedCall(st, initial)
-
-    def make(substeps: int) -> BatchedCall:
-        call.num_substeps = substeps
-        return call
-
-    call.num_substeps = max(min_substeps, calibrate_substeps(make, target_s))
-    return call
+    return call.with_substeps(max(min_substeps, calibrate_substeps(call.with_substeps, target_s)))
 
 
 def _mujoco_entry(arm: MujocoArm, num_copies: int, target_s: float,
                   scenes: tuple[str, ...] = MUJOCO_SCENES) -> tuple[Callable[[], Any], int]:
     """A MuJoCo rollout call of about ``target_s`` and its number of steps."""
-    def make(steps: int) -> Callable[[], Any]:
-        return arm.rollout_call(num_copies, steps, scenes)
-
-    steps = calibrate_substeps(make, target_s, max_substeps=10**6)
+    steps = calibrate_substeps(lambda k: arm.rollout_call(num_copies, k, scenes), target_s,
+                               max_substeps=10**6)
     return arm.rollout_call(num_copies, steps, scenes), steps
 
 
@@ -207,12 +200,17 @@ def _per_copy_step(call: dict[str, Any], num_copies: int, substeps: int) -> dict
                for k, stat in (("", "median"), ("_q1", "q1"), ("_q3", "q3"), ("_min", "min"))}}
 
 
-def _per_copy_rows(calls: dict[str, Callable[[], Any]], substeps: dict[str, int], n: int,
+def _per_copy_rows(entries: dict[str, tuple[Callable[[], Any], int]], n: int,
                    plan: TimingPlan, fields: tuple[str, ...]) -> list[dict[str, Any]]:
-    """Time ``calls`` interleaved; one row per call with its per-copy-step timing."""
-    timed = timing.time_interleaved(calls, plan)
+    """Time the (call, substeps) entries interleaved; a row each, timed per copy-step."""
+    timed = timing.time_interleaved({key: call for key, (call, _) in entries.items()}, plan)
     return [{**dict(zip(fields, key.split("|"), strict=False)),
-             **_per_copy_step(value.summary(), n, substeps[key])} for key, value in timed.items()]
+             **_per_copy_step(value.summary(), n, entries[key][1])}
+            for key, value in timed.items()]
+
+
+def _entry(call: BatchedCall) -> tuple[BatchedCall, int]:
+    return call, call.num_substeps
 
 
 def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
@@ -220,20 +218,13 @@ def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
                 ) -> list[dict[str, Any]]:
     """In-kernel µs per step of each scene: ``step_batch`` with every copy in that scene."""
     n = config.scene_copies
-    calls: dict[str, Callable[[], Any]] = {}
-    substeps: dict[str, int] = {}
-    for case in cases:
-        for scene in case.scenes:
-            key = f"{case.label}|{scene.name}"
-            entry = _batched_entry(steppers[case.label], batch_arrays(case, n, [scene]),
-                                   config.call_s, config.scene_min_substeps)
-            calls[key], substeps[key] = entry, entry.num_substeps
-    if arm is not None:
-        for scene in MUJOCO_SCENES:
-            key = f"mujoco|{scene}"
-            calls[key], substeps[key] = _mujoco_entry(arm, n, config.call_s, (scene,))
-    log(f"in-kernel per scene (N = {n}): {len(calls)} callables, interleaved ...")
-    return _per_copy_rows(calls, substeps, n, config.batch_plan, ("model", "scene"))
+    entries = {f"{case.label}|{scene.name}": _entry(_batched_entry(
+        steppers[case.label], batch_arrays(case, n, [scene]), config.call_s,
+        config.scene_min_substeps)) for case in cases for scene in case.scenes}
+    for scene in MUJOCO_SCENES if arm is not None else ():
+        entries[f"mujoco|{scene}"] = _mujoco_entry(arm, n, config.call_s, (scene,))
+    log(f"in-kernel per scene (N = {n}): {len(entries)} callables, interleaved ...")
+    return _per_copy_rows(entries, n, config.batch_plan, ("model", "scene"))
 
 
 def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
@@ -242,14 +233,11 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
     """µs per copy-step of each model's mix (and MuJoCo's) for every N, interleaved per N."""
     rows = []
     for n in config.copies:
-        calls: dict[str, Callable[[], Any]] = {}
-        substeps: dict[str, int] = {}
-        for case in cases:
-            entry = _batched_entry(steppers[case.label], batch_arrays(case, n), config.call_s)
-            calls[case.label], substeps[case.label] = entry, entry.num_substeps
+        entries = {case.label: _entry(_batched_entry(steppers[case.label], batch_arrays(case, n),
+                                                     config.call_s)) for case in cases}
         if arm is not None:
-            calls["mujoco"], substeps["mujoco"] = _mujoco_entry(arm, n, config.call_s)
-        measured = _per_copy_rows(calls, substeps, n, config.batch_plan, ("model",))
+            entries["mujoco"] = _mujoco_entry(arm, n, config.call_s)
+        measured = _per_copy_rows(entries, n, config.batch_plan, ("model",))
         rows += measured
         log(f"batched N = {n}: " + ", ".join(
             f"{r['model']} {report.format_us(r['per_copy_step_s'])} µs (x{r['substeps']})"
@@ -263,11 +251,10 @@ def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
     if not config.substep_grid:
         return []
     n = config.scene_copies
-    calls = {f"{case.label}|{k}": BatchedCall(steppers[case.label], batch_arrays(case, n), k)
-             for case in cases for k in config.substep_grid}
-    log(f"substeps per call (N = {n}): {len(calls)} callables, interleaved ...")
-    return _per_copy_rows(calls, {key: call.num_substeps for key, call in calls.items()}, n,
-                          config.substep_plan, ("model",))
+    entries = {f"{case.label}|{k}": (BatchedCall(steppers[case.label], batch_arrays(case, n), k),
+                                     k) for case in cases for k in config.substep_grid}
+    log(f"substeps per call (N = {n}): {len(entries)} callables, interleaved ...")
+    return _per_copy_rows(entries, n, config.substep_plan, ("model",))
 
 
 def _state_difference(first: BatchedCall, second: BatchedCall) -> float:
@@ -297,7 +284,7 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
             if key not in variants:
                 log(f"compiling {case.label} with {shortcuts_text(sc.off)} ...")
                 st = stepper(case, sc.off)
-                batch_s = timing.seconds(lambda st=st, case=case: _first_batch(st, case))
+                batch_s = _first_batch_s(st, case)
                 compile_records.append({"stepper": f"{case.label} ({shortcuts_text(sc.off)})",
                                         "step_s": None, "step_batch_s": batch_s})
                 log(f"  first step_batch {batch_s:.1f} s")
@@ -355,35 +342,21 @@ def brake_stop_study(steppers: dict[str, MoreauJeanStepper], arm: MujocoArm | No
 
 def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, Any]]:
     """The speed targets against the measurements (None where the model was not run)."""
-
-    def python_worst(model: str) -> float | None:
-        values = [r["median_s"] for r in single
-                  if r["model"] == model and r["entry"] == "in_place"]
-        return max(values) if values else None
-
-    def batched_at_largest(model: str) -> tuple[float | None, int | None, float | None]:
-        rows = [r for r in batched if r["model"] == model]
-        if not rows:
-            return None, None, None
-        largest = max(rows, key=lambda r: r["copies"])
-        return (largest["per_copy_step_s"], largest["copies"],
-                min(r["per_copy_step_s"] for r in rows))
-
-    def us(seconds: float | None) -> float | None:
-        return None if seconds is None else seconds * 1e6
-
     targets = []
-    for model, title in (("manipulator", "manipulator"), ("diff_drive", "diff-drive")):
-        value, copies, best = batched_at_largest(model)
-        key = "manipulator_batched" if model == "manipulator" else model
+    for model, title, batched_key, python_key in (
+            ("manipulator", "manipulator", "manipulator_batched", "manipulator_python"),
+            ("diff_drive", "diff-drive", "diff_drive", "diff_drive")):
+        rows = [r for r in batched if r["model"] == model]
+        largest = max(rows, key=lambda r: r["copies"], default=None)
         targets.append(report.target_row(
-            f"{title}, batched, µs per copy-step (mix, largest N)", "≤", TARGETS_US[key], "µs",
-            us(value), f"N = {copies}; best over N {report.format_us(best)} µs"
-            if best is not None else ""))
-        key = "manipulator_python" if model == "manipulator" else model
+            f"{title}, batched, µs per copy-step (mix, largest N)", "≤", TARGETS_US[batched_key],
+            "µs", None if largest is None else largest["per_copy_step_s"] * 1e6,
+            "" if largest is None else f"N = {largest['copies']}; best over N "
+            f"{report.format_us(min(r['per_copy_step_s'] for r in rows))} µs"))
+        python = [r["median_s"] for r in single if r["model"] == model and r["entry"] == "in_place"]
         targets.append(report.target_row(
             f"{title}, one InPlaceStepper.step() from Python (slowest scene)", "≤",
-            TARGETS_US[key], "µs", us(python_worst(model))))
+            TARGETS_US[python_key], "µs", max(python) * 1e6 if python else None))
     return targets
 
 
@@ -396,10 +369,7 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
         "config": {"quick": quick, "time_step": TIME_STEP,
                    **{k: v for k, v in asdict(config).items() if k != "shortcut_cases"}},
         "notes": [], "load_log": []}
-
-    def section(name: str) -> None:
-        timing.checkpoint(record, name, log.elapsed)
-
+    section = partial(timing.checkpoint, record, progress=log)
     log(f"engine benchmark ({'quick' if quick else 'full'}) -> {output}; load {timing.load_text()}")
     cases = model_cases(config.models)
     mujoco, mujoco_note = import_mujoco()

@@ -49,6 +49,17 @@ SCENES = ("engaged", "released", "tresca")
 """MuJoCo scenes, in the order of the manipulator's batched mix."""
 
 
+def arm_model(mujoco: Any, dt: float, frictionloss: float = 0.0, lock: float = 0.0) -> Any:
+    """The MJCF arm at time step dt [s], joint 2's frictionloss [N m] and brake lock [rad]."""
+    xml = MJCF.format(dt=dt, rod=1.0 / 12.0, frictionloss=frictionloss, lock=lock)
+    return mujoco.MjModel.from_xml_string(xml)
+
+
+def _settings(solref: Any, solimp: Any) -> dict[str, list[float]]:
+    """A constraint's solref and solimp (JSON-ready)."""
+    return {"solref": [float(x) for x in solref], "solimp": [float(x) for x in solimp]}
+
+
 def import_mujoco() -> tuple[Any, str | None]:
     """(the mujoco module or None, a note when it is missing)."""
     try:
@@ -67,15 +78,11 @@ class MujocoArm:
     def __post_init__(self) -> None:
         mj = self.mujoco
         lock = MANIPULATOR_Q[1] - MANIPULATOR_Q[0]
-        self.plain = self._model(frictionloss=0.0, lock=lock)
-        self.tresca = self._model(frictionloss=TRESCA_BOUND, lock=lock)
+        self.plain = arm_model(mj, TIME_STEP, lock=lock)
+        self.tresca = arm_model(mj, TIME_STEP, frictionloss=TRESCA_BOUND, lock=lock)
         self.state_spec = mj.mjtState.mjSTATE_FULLPHYSICS.value
         self.control_spec = mj.mjtState.mjSTATE_CTRL.value | mj.mjtState.mjSTATE_EQ_ACTIVE.value
         self._rollout = None
-
-    def _model(self, frictionloss: float, lock: float) -> Any:
-        xml = MJCF.format(dt=TIME_STEP, rod=1.0 / 12.0, frictionloss=frictionloss, lock=lock)
-        return self.mujoco.MjModel.from_xml_string(xml)
 
     def _data(self, scene: str) -> tuple[Any, Any]:
         """(model, data) of a scene: the manipulator scenes' state in MuJoCo coordinates."""
@@ -138,11 +145,8 @@ class MujocoArm:
     def brake_stop(self, solref: tuple[float, float] | None, max_steps: int = 10_000
                    ) -> dict[str, Any]:
         """Steps until |q2'| < 1 % of 1 rad/s after the brake engages at q2' = 1 rad/s."""
-        mj = self.mujoco
-        model = self._model(frictionloss=0.0, lock=0.0)
-        if solref is not None:
-            model.eq_solref[0] = solref
-        data = mj.MjData(model)
+        mj, run = self.mujoco, MujocoArmRun(self.mujoco, TIME_STEP, solref)
+        model, data = run.model, run.data
         data.qvel[:] = (0.0, 1.0)
         data.eq_active[0] = 1
         trace = [1.0]
@@ -157,8 +161,7 @@ class MujocoArm:
             if speed < 0.01:
                 steps = k
                 break
-        return {"solref": list(model.eq_solref[0]), "solimp": list(model.eq_solimp[0]),
-                "steps": steps, "relative_angle_at_stop": float(data.qpos[1]),
+        return {**run.brake_settings, "steps": steps, "relative_angle_at_stop": float(data.qpos[1]),
                 "largest_relative_angle": largest_angle, "relative_speed_trace": trace}
 
     def close(self) -> None:
@@ -214,8 +217,7 @@ class MujocoBall:
     @property
     def contact_settings(self) -> dict[str, list[float]]:
         """The ball geom's solref and solimp as compiled (JSON-ready)."""
-        return {"solref": [float(x) for x in self.model.geom_solref[1]],
-                "solimp": [float(x) for x in self.model.geom_solimp[1]]}
+        return _settings(self.model.geom_solref[1], self.model.geom_solimp[1])
 
     def _reset(self, gap: float) -> None:
         self.mujoco.mj_resetData(self.model, self.data)
@@ -290,8 +292,7 @@ class MujocoArmRun:
     solref: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        xml = MJCF.format(dt=self.time_step, rod=1.0 / 12.0, frictionloss=0.0, lock=0.0)
-        self.model = self.mujoco.MjModel.from_xml_string(xml)
+        self.model = arm_model(self.mujoco, self.time_step)
         if self.solref is not None:
             self.model.eq_solref[0] = self.solref
         self.data = self.mujoco.MjData(self.model)
@@ -299,8 +300,7 @@ class MujocoArmRun:
     @property
     def brake_settings(self) -> dict[str, list[float]]:
         """The brake equality's solref and solimp (JSON-ready)."""
-        return {"solref": [float(x) for x in self.model.eq_solref[0]],
-                "solimp": [float(x) for x in self.model.eq_solimp[0]]}
+        return _settings(self.model.eq_solref[0], self.model.eq_solimp[0])
 
     def state(self) -> np.ndarray:
         """(alpha, beta, alpha', beta') in our coordinates [rad, rad/s]."""
@@ -327,7 +327,3 @@ class MujocoArmRun:
                 mj.mj_step(model, data, nstep=stride)
                 samples.append(self.state())
         return self.state(), None if samples is None else np.array(samples)
-
-
-__all__ = ["MJCF", "SCENES", "MujocoArm", "MujocoArmRun", "MujocoBall", "calibrate_dampratio",
-           "formula_dampratio", "import_mujoco"]

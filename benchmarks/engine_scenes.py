@@ -77,16 +77,14 @@ BLOCK_SCENES = (
 )
 
 
-def _manipulator_scenes() -> tuple[Scene, ...]:
-    state = {"q": MANIPULATOR_Q, "u": MANIPULATOR_U, "tau": (MOTOR_TORQUE,)}
-    return (
-        Scene("engaged", "brake engaged (bound inf), relative velocity 0.5 rad/s: a plastic "
-              "brake impact, then a rigid arm", brake=(np.inf,), **state),
-        Scene("released", "brake released (bound 0): no constraint, no solve", brake=(0.0,),
-              **state),
-        Scene("tresca", f"Tresca brake, bound {TRESCA_BOUND} N m: slipping (LCP of size 2)",
-              brake=(TRESCA_BOUND,), **state),
-    )
+_ARM = {"q": MANIPULATOR_Q, "u": MANIPULATOR_U, "tau": (MOTOR_TORQUE,)}
+MANIPULATOR_SCENES = (
+    Scene("engaged", "brake engaged (bound inf), relative velocity 0.5 rad/s: a plastic brake "
+          "impact, then a rigid arm", brake=(np.inf,), **_ARM),
+    Scene("released", "brake released (bound 0): no constraint, no solve", brake=(0.0,), **_ARM),
+    Scene("tresca", f"Tresca brake, bound {TRESCA_BOUND} N m: slipping (LCP of size 2)",
+          brake=(TRESCA_BOUND,), **_ARM),
+)
 
 
 DIFF_DRIVE_SCENES = (
@@ -107,7 +105,7 @@ def model_cases(names: Sequence[str]) -> list[ModelCase]:
                           mix=("resting", "bouncing")),
         "block": ModelCase("block", mechanics.SlidingBlock, BLOCK_SCENES),
         "manipulator": ModelCase("manipulator", mechanics.BlockableManipulator,
-                                 _manipulator_scenes()),
+                                 MANIPULATOR_SCENES),
         "diff_drive": ModelCase("diff_drive", mechanics.DiffDriveRobot, DIFF_DRIVE_SCENES),
     }
     return [available[n] for n in names]
@@ -118,14 +116,9 @@ def batch_arrays(case: ModelCase, num_copies: int, scenes: Sequence[Scene] | Non
     """(Q, U, TAU, BRAKE) for ``num_copies`` copies; copy i gets scene i mod len(scenes)."""
     chosen = list(scenes or case.mix_scenes)
     picks = [chosen[i % len(chosen)] for i in range(num_copies)]
-    model = case.model
-    brake = np.array([s.brake for s in picks], dtype=float).reshape(num_copies, model.NUM_BRAKES)
-    return (
-        np.array([s.q for s in picks], dtype=float),
-        np.array([s.u for s in picks], dtype=float),
-        np.array([s.tau for s in picks], dtype=float),
-        brake,
-    )
+    q, u, tau, brake = (np.array([getattr(s, name) for s in picks], dtype=float)
+                        for name in ("q", "u", "tau", "brake"))
+    return q, u, tau, brake.reshape(num_copies, case.model.NUM_BRAKES)
 
 
 @dataclass
@@ -150,6 +143,11 @@ class BatchedCall:
     def num_copies(self) -> int:
         """N."""
         return self.initial[0].shape[0]
+
+    def with_substeps(self, num_substeps: int) -> BatchedCall:
+        """This call, set to ``num_substeps`` substeps."""
+        self.num_substeps = num_substeps
+        return self
 
     def __call__(self) -> None:
         """Restart from the initial states and advance ``num_substeps`` steps."""
@@ -181,8 +179,3 @@ def stepper(case: ModelCase, shortcuts: StepShortcuts | None = None) -> MoreauJe
     """The stepper of ``case`` with ``shortcuts`` (default all on; compiles on first use)."""
     return MoreauJeanStepper(case.model, time_step=TIME_STEP,
                              shortcuts=StepShortcuts() if shortcuts is None else shortcuts)
-
-
-__all__ = ["BLOCK_SCENES", "DIFF_DRIVE_SCENES", "MANIPULATOR_Q", "MANIPULATOR_U", "MOTOR_TORQUE",
-           "TIME_STEP", "TRESCA_BOUND", "BatchedCall", "ModelCase", "Scene", "batch_arrays",
-           "calibrate_substeps", "model_cases", "stepper"]

@@ -70,8 +70,3 @@ def size_study_entries(n: int) -> list[Entry]:
     """The driver methods applicable at size n, plus QuantEcon's Lemke for reference."""
     methods = [m for m in LCP_METHODS if m != "enumerative" or n <= ENUMERATIVE_MAX_N]
     return [driver_entry(m) for m in methods] + [QUANTECON]
-
-
-__all__ = ["DRIVER_LEMKE", "ENUMERATIVE_MAX_N", "KERNEL", "LCP_METHODS", "QUANTECON",
-           "QUANTECON_MAX_ITER", "QUANTECON_STATUS", "Entry", "Outcome", "driver_entry",
-           "size_study_entries"]

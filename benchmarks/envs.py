@@ -174,7 +174,7 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
                      log: Callable[[str], None]
                      ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """``env.step`` through ``gym.make`` and unwrapped, for ours and the peers, interleaved."""
-    records, unavailable, calls = [], [], {}
+    records, unavailable = [], []
     loops: dict[str, StepLoop] = {}
     for env_id in (*env_ids, *peers):
         log(f"making {env_id} (first make/reset/step; numba compiles ours) ...")
@@ -186,25 +186,21 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
             log(f"  {env_id} not measured: {unavailable[-1]['error']}")
             continue
         records.append(record)
-        loops[f"{env_id}|gym.make"] = wrapped
-        loops[f"{env_id}|unwrapped"] = bare
-    calls.update(loops)
-    log(f"single env: {len(calls)} step loops, interleaved; load {timing.load_text()} ...")
-    timed = timing.time_interleaved(calls, config.step_plan)
+        loops[f"{env_id}|gym.make"], loops[f"{env_id}|unwrapped"] = wrapped, bare
+    log(f"single env: {len(loops)} step loops, interleaved; load {timing.load_text()} ...")
+    timed = timing.time_interleaved(loops, config.step_plan)
     for record in records:
         for entry in ("gym.make", "unwrapped"):
-            key = f"{record['env_id']}|{entry}"
-            loop = loops[key]
-            summary = timed[key].summary(operations_per_call=loop.steps_per_call)
+            loop = loops[f"{record['env_id']}|{entry}"]
+            summary = timed[f"{record['env_id']}|{entry}"].summary(loop.steps_per_call)
             record[entry] = {
                 **{f"{stat}_us": summary[f"{stat}_s"] * 1e6 for stat in ("median", "q1", "q3",
                                                                          "min")},
                 "rounds": summary["rounds"], "number": summary["number"],
                 "steps_per_call": loop.steps_per_call, "steps_total": loop.steps,
                 "episodes_ended": loop.episodes}
+            loop.env.close()
         record["per_physics_step_us"] = record["gym.make"]["median_us"] / record["frame_skip"]
-        loops[f"{record['env_id']}|gym.make"].env.close()
-        loops[f"{record['env_id']}|unwrapped"].env.close()
     _add_ratios(records)
     return records, unavailable
 
@@ -267,18 +263,16 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str]
                 log(f"  {key} N = {n} not measured: {unavailable[-1]['error']}")
         if not loops:
             continue
-        timed = timing.time_interleaved(loops, config.vector_plan)
         measured = []
-        for key, value in timed.items():
+        for key, value in timing.time_interleaved(loops, config.vector_plan).items():
             summary = value.summary()
-            row = {**meta[key], "call": summary,
-                   **{f"env_steps_per_s{k}": n / summary[f"{stat}_s"] for k, stat in
-                      (("", "median"), ("_q1", "q3"), ("_q3", "q1"), ("_best", "min"))},
-                   "per_env_step_us": summary["median_s"] / n * 1e6}
-            for name in ("", "_q1", "_q3", "_best"):
-                row[f"physics_steps_per_s{name}"] = (row[f"env_steps_per_s{name}"]
-                                                      * meta[key]["frame_skip"])
-            measured.append(row)
+            rates = (("", "median"), ("_q1", "q3"), ("_q3", "q1"), ("_best", "min"))
+            measured.append({
+                **meta[key], "call": summary,
+                **{f"env_steps_per_s{k}": n / summary[f"{stat}_s"] for k, stat in rates},
+                "per_env_step_us": summary["median_s"] / n * 1e6,
+                **{f"physics_steps_per_s{k}": n / summary[f"{stat}_s"] * meta[key]["frame_skip"]
+                   for k, stat in rates}})
             loops[key].env.close()
         rows += measured
         log(f"vector N = {n}: " + ", ".join(
@@ -358,11 +352,11 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None
             "units": UNITS, "targets_brief": TARGETS, "notes": [], "load_log": []}
         log(f"env benchmark ({'quick' if quick else 'full'}) -> {output}; pinned to "
             f"{pinning['cpus']}; load {timing.load_text()}")
-        timing.checkpoint(record, "single env", progress.elapsed)
+        timing.checkpoint(record, "single env", progress)
         single, unavailable = single_env_study(env_ids, config.peers, config, log)
-        timing.checkpoint(record, "vector env", progress.elapsed)
+        timing.checkpoint(record, "vector env", progress)
         vector, vector_unavailable = vector_study(env_ids, config, log)
-        timing.checkpoint(record, "end", progress.elapsed)
+        timing.checkpoint(record, "end", progress)
         for item in (*unavailable, *vector_unavailable):
             record["notes"].append(f"{item['env_id']}"
                                    f"{' (' + item['mode'] + ')' if 'mode' in item else ''} "

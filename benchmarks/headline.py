@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from benchmarks.report import markdown_table
+from benchmarks.report import markdown_table, target_row
 
 SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
            ("precision", "work_precision.json"), ("stress", "stress.json"),
@@ -14,20 +14,13 @@ SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
 """(benchmark name, result file) whose targets enter the table, in this order."""
 
 
-def target_rows(name: str, record: dict[str, Any]) -> list[dict[str, Any]]:
-    """The ``targets`` of one record (``benchmarks.report.target_row``), with the benchmark."""
-    return [{"benchmark": name, **target, "met": bool(target.get("met"))}
-            for target in record.get("targets") or []]
-
-
 def stress_row(record: dict[str, Any]) -> dict[str, Any]:
     """One row summarizing the stress cases: passed of total, failures named."""
     cases = record.get("cases") or []
     failed = [case["name"] for case in cases if not case.get("passed")]
-    return {"benchmark": "stress", "target": "every stress case passes its criteria",
-            "measured": len(cases) - len(failed), "threshold": len(cases),
-            "unit": "cases", "comparison": "=", "met": bool(cases) and not failed,
-            "note": ("failed: " + ", ".join(failed)) if failed else ""}  # fmt: skip
+    return target_row("every stress case passes its criteria", "=", len(cases), "cases",
+                      len(cases) - len(failed), ("failed: " + ", ".join(failed)) if failed else "",
+                      met=bool(cases) and not failed)
 
 
 def engine_peer_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
@@ -35,28 +28,20 @@ def engine_peer_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
     rows = []
     largest: dict[str, dict[str, Any]] = {}
     for entry in record.get("batched") or []:
-        if entry["model"] in ("manipulator", "mujoco"):
-            if entry["copies"] >= largest.get(entry["model"], {}).get("copies", 0):
-                largest[entry["model"]] = entry
-    if len(largest) == 2:
-        ours, peer = largest["manipulator"], largest["mujoco"]
-        rows.append({
-            "benchmark": "engine", "target": "manipulator step vs MuJoCo arm (rollout), "
-            f"batched N = {ours['copies']}: MuJoCo time / ours",
-            "measured": peer["per_copy_step_s"] / ours["per_copy_step_s"], "threshold": None,
-            "unit": "×", "comparison": "", "met": peer["per_copy_step_s"] > ours["per_copy_step_s"],
-            "note": f"ours {ours['per_copy_step_s'] * 1e6:.3g} µs, MuJoCo "
-                    f"{peer['per_copy_step_s'] * 1e6:.3g} µs per copy-step",
-        })  # fmt: skip
+        if entry["copies"] >= largest.get(entry["model"], {}).get("copies", 0):
+            largest[entry["model"]] = entry
+    if "manipulator" in largest and "mujoco" in largest:
+        ours, peer = largest["manipulator"]["per_copy_step_s"], largest["mujoco"]["per_copy_step_s"]
+        rows.append(target_row(
+            "manipulator step vs MuJoCo arm (rollout), batched N = "
+            f"{largest['manipulator']['copies']}: MuJoCo time / ours", "", None, "×", peer / ours,
+            f"ours {ours * 1e6:.3g} µs, MuJoCo {peer * 1e6:.3g} µs per copy-step", peer > ours))
     stop = record.get("brake_stop") or {}
     if "ours" in stop and "mujoco_default" in stop:
-        ours_steps, peer_steps = stop["ours"]["steps"], stop["mujoco_default"]["steps"]
-        rows.append({
-            "benchmark": "engine", "target": "brake stops relative motion (< 1 %) within one step",
-            "measured": ours_steps, "threshold": 1, "unit": "steps", "comparison": "≤",
-            "met": ours_steps <= 1,
-            "note": f"MuJoCo eq_active, default solref: {peer_steps} steps",
-        })  # fmt: skip
+        rows.append(target_row(
+            "brake stops relative motion (< 1 %) within one step", "≤", 1, "steps",
+            stop["ours"]["steps"], "MuJoCo eq_active, default solref: "
+            f"{stop['mujoco_default']['steps']} steps", stop["ours"]["steps"] <= 1))
     return rows
 
 
@@ -72,31 +57,22 @@ def write_headline(folder: Path) -> str:
     rows: list[dict[str, Any]] = []
     runs = {}
     for name, filename in SOURCES:
-        path = folder / filename
-        if not path.exists():
+        if not (folder / filename).exists():
             continue
-        record = json.loads(path.read_text())
+        record = json.loads((folder / filename).read_text())
         runs[name] = {"file": filename, "machine": record.get("machine"),
                       "run_time_s": record.get("run_time_s"), "quick": record.get("quick")}
-        rows.extend(target_rows(name, record))
-        if name == "engine":
-            rows.extend(engine_peer_rows(record))
-        if name == "stress":
-            rows.append(stress_row(record))
+        extra = {"engine": engine_peer_rows, "stress": lambda r: [stress_row(r)]}.get(name)
+        rows += [{"benchmark": name, **target, "met": bool(target.get("met"))}
+                 for target in (record.get("targets") or []) + (extra(record) if extra else [])]
     (folder / "headline.json").write_text(json.dumps({"runs": runs, "rows": rows}, indent=1,
                                                      default=str) + "\n")  # fmt: skip
-    if not rows:
-        text = f"no benchmark results with targets in {folder}"
-    else:
-        text = markdown_table(
-            [[r["benchmark"], r["target"], f"{_number(r['measured'])} {r['unit']}".strip(),
-              "(comparison)" if r["threshold"] is None
-              else f"{r['comparison']} {_number(r['threshold'])} {r['unit']}".strip(),
-              "yes" if r["met"] else "**no**", r["note"]] for r in rows],
-            ["benchmark", "target", "measured", "target value", "met", "note"],
-        )  # fmt: skip
+    text = markdown_table(
+        [[r["benchmark"], r["target"], f"{_number(r['measured'])} {r['unit']}".strip(),
+          "(comparison)" if r["threshold"] is None
+          else f"{r['comparison']} {_number(r['threshold'])} {r['unit']}".strip(),
+          "yes" if r["met"] else "**no**", r["note"]] for r in rows],
+        ["benchmark", "target", "measured", "target value", "met", "note"],
+    ) if rows else f"no benchmark results with targets in {folder}"  # fmt: skip
     (folder / "headline.md").write_text(text + "\n")
     return text
-
-
-__all__ = ["SOURCES", "engine_peer_rows", "stress_row", "target_rows", "write_headline"]

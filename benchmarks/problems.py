@@ -89,7 +89,3 @@ def peer_lcp_problems(root: Path | None = None) -> list[Problem]:
         M, q = read_lcp(path)
         problems.append(Problem(path.stem, "siconos", q.shape[0], np.ascontiguousarray(M), q))
     return problems
-
-
-__all__ = ["FAMILIES", "SEED", "Problem", "contact_lcp", "peer_data_dir", "peer_lcp_problems",
-           "random_problem", "spd_lcp"]

@@ -181,8 +181,3 @@ def json_safe(value: Any) -> Any:
 def write_json(record: dict[str, Any], path: Path) -> None:
     """Write the full record (indented; numpy scalars as Python numbers)."""
     path.write_text(json.dumps(record, indent=1, default=lambda v: v.item()) + "\n")
-
-
-__all__ = ["bars", "flat_table", "format_number", "format_us", "json_safe", "log_lines",
-           "markdown_table", "plt", "run_line", "save_figure", "summary", "target_row",
-           "targets_table", "write_json"]

@@ -7,7 +7,7 @@ the driver ``solve_lcp`` and its compiled entry ``lemke_solve``, interleaved wit
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -93,22 +93,15 @@ def size_study(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
     records = []
     for family in FAMILIES:
         for n in config.sizes:
-            chosen = E.size_study_entries(n)
-            for instance in range(config.instances):
-                problem = random_problem(family, n, instance)
-                for name, measured in time_problem(problem, chosen, config.size_plan).items():
-                    records.append(
-                        {"family": family, "n": n, "instance": instance, "entry": name, **measured}
-                    )
-            latest = [r for r in records if r["family"] == family and r["n"] == n]
-            log(f"size study {family} n={n}: " + _progress_cells(latest))
+            latest = [{"family": family, "n": n, "instance": i, "entry": name, **measured}
+                      for i in range(config.instances) for name, measured in time_problem(
+                          random_problem(family, n, i), E.size_study_entries(n),
+                          config.size_plan).items()]
+            records += latest
+            log(f"size study {family} n={n}: " + ", ".join(
+                f"{r['entry']} {report.format_us(r['time_median_s'])} µs"
+                for r in aggregate_size_study(latest)))
     return records
-
-
-def _progress_cells(records: Sequence[dict[str, Any]]) -> str:
-    """``entry median-µs`` for each entry of one (family, n), median over instances."""
-    rows = aggregate_size_study(records)
-    return ", ".join(f"{r['entry']} {report.format_us(r['time_median_s'])} µs" for r in rows)
 
 
 def comparison_problems(config: BenchConfig, log: Progress) -> list[Problem]:
@@ -177,12 +170,6 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
     return markdown_report(record)
 
 
-def _median(values: Iterable[float]) -> float:
-    """Median of an iterable of floats (NaN when empty)."""
-    array = np.fromiter(values, dtype=float)
-    return float(np.median(array)) if array.size else float("nan")
-
-
 def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """Combine the instances of each (family, n, entry) of the work-size study."""
     frame = pd.json_normalize(list(records))
@@ -205,8 +192,8 @@ def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
         "Siconos peer files solved by all three": [r for r in solved if r["family"] == "siconos"],
     }
     return [{"set": name, "problems": len(members),
-             "median_ratio_driver": _median(r["ratio_driver"] for r in members),
-             "median_ratio_kernel": _median(r["ratio_kernel"] for r in members)}
+             "median_ratio_driver": float(np.median([r["ratio_driver"] for r in members])),
+             "median_ratio_kernel": float(np.median([r["ratio_kernel"] for r in members]))}
             for name, members in sets.items() if members]
 
 

@@ -88,22 +88,17 @@ def _number(value: Any) -> str:
     return f"{value:.3g}" if math.isfinite(value) else str(value)
 
 
-def _parameters(parameters: Mapping[str, Any]) -> str:
-    """``key=value`` pairs of a case's parameters, floats with four significant digits."""
-    def text(value: Any, digits: int) -> str:
-        return f"{value:.{digits}g}" if isinstance(value, float) else str(value)
-
-    return ", ".join(f"{key}=" + (",".join(text(v, 3) for v in value)
-                                  if isinstance(value, (list, tuple)) else text(value, 4))
-                     for key, value in parameters.items())  # fmt: skip
+def _text(value: Any, digits: int) -> str:
+    """A parameter: floats with ``digits`` significant digits, lists comma-separated at 3."""
+    if isinstance(value, (list, tuple)):
+        return ",".join(_text(v, 3) for v in value)
+    return f"{value:.{digits}g}" if isinstance(value, float) else str(value)
 
 
-def _criteria(criteria: Mapping[str, Mapping[str, Any]]) -> str:
-    """``name value <= limit`` per criterion, failures in bold."""
-    parts = [f"{name} {_number(c['value'])} {c['relation']} {_number(c['limit'])}"
-             for name, c in criteria.items()]
-    return "; ".join(part if c["passed"] else f"**{part} FAIL**"
-                     for part, c in zip(parts, criteria.values(), strict=True))
+def _criterion(name: str, c: Mapping[str, Any]) -> str:
+    """``name value <= limit``, in bold with FAIL when it failed."""
+    part = f"{name} {_number(c['value'])} {c['relation']} {_number(c['limit'])}"
+    return part if c["passed"] else f"**{part} FAIL**"
 
 
 def markdown_report(record: Mapping[str, Any]) -> str:
@@ -111,8 +106,10 @@ def markdown_report(record: Mapping[str, Any]) -> str:
     cases = record["cases"]
     failed = [c["name"] for c in cases if not c["passed"]]
     mode = "quick" if (record.get("config") or {}).get("quick") else "full"
-    rows = [{"case": c["name"], "parameters": _parameters(c["parameters"]),
-             "criteria (value relation limit)": _criteria(c["criteria"]),
+    rows = [{"case": c["name"],
+             "parameters": ", ".join(f"{k}={_text(v, 4)}" for k, v in c["parameters"].items()),
+             "criteria (value relation limit)": "; ".join(
+                 _criterion(name, criterion) for name, criterion in c["criteria"].items()),
              "result": "PASS" if c["passed"] else "**FAIL**"} for c in cases]
     lines = [f"Stress test ({mode}): {len(cases) - len(failed)} of {len(cases)} cases pass"
              + (f"; failing: {', '.join(failed)}" if failed else "")

@@ -7,6 +7,7 @@ call each), so a phase of load on the shared machine hits every entry it compare
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as dt
 import json
 import math
@@ -101,13 +102,6 @@ def probe_first_calls(cold: bool) -> dict[str, Any]:
     return json.loads(process.stdout)
 
 
-def _package_version(name: str) -> str | None:
-    try:
-        return metadata.version(name)
-    except metadata.PackageNotFoundError:
-        return None
-
-
 def _cpu_model() -> str:
     """CPU model name from /proc/cpuinfo, falling back to ``platform.processor()``."""
     try:
@@ -151,9 +145,13 @@ def speed_probe(samples: int = 200, number: int = 5000) -> dict[str, float]:
 
 def seconds(action: Callable[[], Any]) -> float:
     """Wall-clock seconds of one call of ``action()``."""
-    start = time.perf_counter()
-    action()
-    return time.perf_counter() - start
+    return _timed_call(action)[1]
+
+
+def _version(name: str) -> str | None:
+    with contextlib.suppress(metadata.PackageNotFoundError):
+        return metadata.version(name)
+    return None
 
 
 def load_text() -> str:
@@ -162,10 +160,10 @@ def load_text() -> str:
     return f"{load[0]:.2f}" if load else "n/a"
 
 
-def checkpoint(record: dict[str, Any], section: str, elapsed_s: float) -> None:
+def checkpoint(record: dict[str, Any], section: str, progress: Progress) -> None:
     """Append the load average at the start of ``section`` to ``record["load_log"]``."""
     record.setdefault("load_log", []).append(
-        {"section": section, "elapsed_s": elapsed_s, "load_average": load_average()})
+        {"section": section, "elapsed_s": progress.elapsed, "load_average": load_average()})
 
 
 def finish(record: dict[str, Any], elapsed_s: float, speed: bool = False) -> None:
@@ -216,11 +214,6 @@ def machine_info(packages: tuple[str, ...] = VERSIONED_PACKAGES) -> dict[str, An
         "cpu_affinity": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None,
         "load_average_at_start": load_average(),
         "speed_probe_at_start": speed_probe(),
-        "versions": {name: _package_version(name) for name in packages},
+        "versions": {name: _version(name) for name in packages},
         "git_commit": git_commit(),
     }
-
-
-__all__ = ["VERSIONED_PACKAGES", "Progress", "Timed", "TimingPlan", "arguments", "checkpoint",
-           "finish", "load_average", "load_text", "machine_info", "probe_first_calls", "seconds",
-           "speed_probe", "time_interleaved"]

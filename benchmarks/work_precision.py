@@ -20,40 +20,21 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks import engine_mujoco as mj
 from benchmarks import report, timing
-from benchmarks.engine_mujoco import (
-    MujocoArmRun,
-    MujocoBall,
-    calibrate_dampratio,
-    formula_dampratio,
-    import_mujoco,
-)
-from benchmarks.report import format_number as _format
-from benchmarks.report import log_lines, plt, save_figure, summary
+from benchmarks.report import format_number, log_lines, plt, save_figure, summary
 from benchmarks.timing import Progress, TimingPlan
-from mdi_envs.mechanics.models import (
-    BlockableManipulator,
-    BouncingBall,
-    DiffDriveRobot,
-    SlidingBlock,
-)
+from mdi_envs import stepping
+from mdi_envs.mechanics import models
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
 from mdi_envs.mechanics.models.sliding_block import SlidingBlockParameters
 from mdi_envs.solvers.status import SolverStatus
-from mdi_envs.stepping import (
-    MoreauJeanStepper,
-    PiecewiseConstant,
-    StepShortcuts,
-    bang_bang,
-    brake_schedule,
-    simulate_ball,
-    simulate_manipulator,
-)
 from mdi_envs.stepping._kernel import INFO_STATUS
 from mdi_envs.stepping.event_driven import EVENT_APEX, EVENT_IMPACT, Trajectory
 
 Log = Callable[[str], None]
-METHODS = {"enumerative": StepShortcuts(), "lemke": StepShortcuts(direct_solve_max_size=0)}
+METHODS = {"enumerative": stepping.StepShortcuts(),
+           "lemke": stepping.StepShortcuts(direct_solve_max_size=0)}
 ATOL_PER_RTOL = 1e-2  # event-driven runs: atol = ATOL_PER_RTOL * rtol
 BOUNCES = 3  # ball apexes compared (impacts 2 .. BOUNCES + 1 for the times)
 # The manipulator's scenario [s, N m]: the paper's brake schedule and a torque reversal.
@@ -146,6 +127,9 @@ class Context:
     compile: list[dict[str, Any]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     failed_sections: list[str] = field(default_factory=list)
+    references: dict[str, Any] = field(default_factory=dict)
+    calibrations: list[dict[str, Any]] = field(default_factory=list)
+    reference: Any = None  # the manipulator's reference states (S, 4) at the sample times
     _compiled: set[tuple[str, str]] = field(default_factory=set)
 
     def timed(self, call: Callable[[], Any]) -> tuple[float, int, Any]:
@@ -157,30 +141,35 @@ class Context:
         return t.min_s, t.rounds * t.number, t.result
 
     def stepper(self, model: Any, parameters: Any, dt: float, method: str = "enumerative",
-                locate_impacts: bool = False) -> MoreauJeanStepper:
+                locate_impacts: bool = False) -> stepping.MoreauJeanStepper:
         """A stepper; the first of each (model, method, location) is compiled and timed here."""
-        st = MoreauJeanStepper(model, parameters, dt, METHODS[method], locate_impacts)
+        st = stepping.MoreauJeanStepper(model, parameters, dt, METHODS[method], locate_impacts)
         variant = method + (", locate_impacts" if locate_impacts else "")
         key = (model.__name__, variant)
         if key not in self._compiled:
             self.log(f"compiling {model.__name__} step_batch ({variant}) ...")
-            start = time.perf_counter()
-            Copies(st, np.zeros((1, st.num_dofs)), np.zeros((1, st.num_dofs))).advance(1)
-            seconds = time.perf_counter() - start
+            seconds = timing.seconds(lambda: Copies(st).advance(1))
             self.compile.append({"model": model.__name__, "method": variant,
                                  "first_step_batch_s": seconds})
             self.log(f"  {seconds:.1f} s")
             self._compiled.add(key)
         return st
 
+    def copies(self, model: Any, parameters: Any, dt: float, method: str = "enumerative"
+               ) -> Copies:
+        """One copy at rest at the origin, of ``stepper(model, parameters, dt, method)``."""
+        return Copies(self.stepper(model, parameters, dt, method))
+
 
 class Copies:
     """N copies of one stepper's state with preallocated ``step_batch`` arguments."""
 
-    def __init__(self, stepper: MoreauJeanStepper, q0: np.ndarray, u0: np.ndarray) -> None:
+    def __init__(self, stepper: stepping.MoreauJeanStepper, q0: np.ndarray | None = None,
+                 u0: np.ndarray | None = None) -> None:
+        """N copies from states q0, u0 (N, n) [SI] (default: one copy at rest at the origin)."""
         self.stepper = stepper
-        self.q0 = np.array(q0, dtype=np.float64)
-        self.u0 = np.array(u0, dtype=np.float64)
+        self.q0 = np.zeros((1, stepper.num_dofs)) if q0 is None else np.array(q0, dtype=float)
+        self.u0 = np.zeros_like(self.q0) if u0 is None else np.array(u0, dtype=float)
         n = self.q0.shape[0]
         self.q, self.u = self.q0.copy(), self.u0.copy()
         self.tau = np.zeros((n, stepper.num_inputs))
@@ -331,11 +320,6 @@ def _ball_setup(ctx: Context) -> tuple[BouncingBallParameters, WorkPrecisionConf
     return p, ctx.config, gaps, ball_horizon(p, gaps)
 
 
-def _ball_initial(p: BouncingBallParameters, gaps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    q0 = np.column_stack([np.zeros(gaps.size), p.radius + gaps])
-    return q0, np.zeros_like(q0)
-
-
 def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
     """Moreau-Jean ball points: per method and dt, drop 0 timed, D drops replayed step by step."""
     p, config, gaps, horizon = _ball_setup(ctx)
@@ -343,11 +327,12 @@ def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
     variants = [(f"mj_{method}", method, False) for method in config.methods]
     for series, method, locate_impacts in [*variants, ("mj_located", "enumerative", True)]:
         for dt in config.ball_time_steps:
-            st = ctx.stepper(BouncingBall, p, dt, method, locate_impacts)
+            st = ctx.stepper(models.BouncingBall, p, dt, method, locate_impacts)
             num_steps = math.ceil(horizon / dt)
-            single = Copies(st, *(a[:1] for a in _ball_initial(p, gaps)))
+            q0 = np.column_stack([np.zeros(gaps.size), p.radius + gaps])  # at rest
+            single = Copies(st, q0[:1])
             wall, repeats, final = ctx.timed(partial(single.run, [(num_steps, (0.0,), ())]))
-            replay = Copies(st, *_ball_initial(p, gaps))
+            replay = Copies(st, q0)
             y = np.empty((gaps.size, num_steps + 1))
             v = np.empty_like(y)
             y[:, 0], v[:, 0] = replay.q[:, 1], replay.u[:, 1]
@@ -366,32 +351,32 @@ def ball_event_driven(ctx: Context) -> list[dict[str, Any]]:
     points = []
     for rtol in config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
-        wall, repeats, _ = ctx.timed(partial(simulate_ball, p, p.radius + gaps[0], horizon,
+        wall, repeats, _ = ctx.timed(partial(stepping.simulate_ball, p, p.radius + gaps[0], horizon,
                                              **options))
-        runs = [simulate_ball(p, p.radius + gap, horizon, **options) for gap in gaps]
+        runs = [stepping.simulate_ball(p, p.radius + gap, horizon, **options) for gap in gaps]
         points.append(point(ctx.log, "ball", "event_driven", "rtol", rtol, wall, repeats, "ed",
                             ball_event_errors(p, gaps, runs), atol=options["atol"],
                             rhs_evaluations=runs[0].num_rhs_evals))
     return points
 
 
-def ball_mujoco(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """MuJoCo ball points per dampratio mapping and dt, and the calibration records."""
+def ball_mujoco(ctx: Context) -> list[dict[str, Any]]:
+    """MuJoCo ball points per dampratio mapping and dt (the calibrations into ``ctx``)."""
     p, config, gaps, horizon = _ball_setup(ctx)
     points, calibrations = [], []
     for series in config.mujoco_ball_series:
         for dt in config.mujoco_ball_time_steps:
             name = f"mujoco_{series}"
             if series == "formula":
-                dampratio: float | None = formula_dampratio(p.restitution)
+                dampratio: float | None = mj.formula_dampratio(p.restitution)
                 note = "damped-oscillator formula"
             else:
-                dampratio, note = calibrate_dampratio(ctx.mujoco, p, dt)
+                dampratio, note = mj.calibrate_dampratio(ctx.mujoco, p, dt)
             if dampratio is None:
                 points.append(point(ctx.log, "ball", name, "dt", dt, None, 0, "",
                                     {"error": math.nan}, status=f"failed: {note}"))
                 continue
-            ball = MujocoBall(ctx.mujoco, p, dt, dampratio)
+            ball = mj.MujocoBall(ctx.mujoco, p, dt, dampratio)
             restitution = ball.effective_restitution()
             calibrations.append({"series": name, "dt": dt, "dampratio": dampratio,
                                  "effective_restitution": restitution, "note": note,
@@ -404,7 +389,8 @@ def ball_mujoco(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, Any]
                 ctx.log, "ball", name, "dt", dt, wall, repeats, "mujoco_one_call",
                 ball_errors(p, gaps, y, v, dt), replay_difference=float(difference),
                 dampratio=dampratio, effective_restitution=restitution))
-    return points, calibrations
+    ctx.calibrations = calibrations
+    return points
 
 
 def stick_slip_closed_form(theta: float, mu: float, mass: float, rate: float, gravity: float
@@ -455,7 +441,7 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
         a = max(p.gravity * (math.sin(p.slope_angle)
                              - p.friction_coefficient * math.cos(p.slope_angle)), 0.0)
         num_steps = _steps(1.0, dt)
-        run = Copies(ctx.stepper(SlidingBlock, p, dt, method), np.zeros((1, 2)), np.zeros((1, 2)))
+        run = ctx.copies(models.SlidingBlock, p, dt, method)
         wall, repeats, final = ctx.timed(partial(run.run, [(num_steps, (0.0,), ())]))
         exact = np.array([0.5 * a, 0.0, a, 0.0])  # (s, n, s', n') at T = 1 s
         errors = {"error": float(np.abs(final - exact).max())}
@@ -465,7 +451,7 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
         p.slope_angle, p.friction_coefficient, p.mass, STICK_SLIP["rate"], p.gravity)
     num_steps = round((t_s + 0.5) / dt)
     pushes = np.array([push((k + 0.5) * dt) for k in range(num_steps)])
-    run = Copies(ctx.stepper(SlidingBlock, p, dt, method), np.zeros((1, 2)), np.zeros((1, 2)))
+    run = ctx.copies(models.SlidingBlock, p, dt, method)
     speeds = np.empty(num_steps)
 
     def per_step() -> np.ndarray:
@@ -485,10 +471,10 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
                   "speed_error": speed_error})
 
 
-def manipulator_schedule() -> tuple[PiecewiseConstant, PiecewiseConstant, list[float]]:
+def manipulator_schedule() -> tuple[Any, Any, list[float]]:
     """(torque tau(t) [N m], brake bound a(t), phase boundaries [s] from 0 to the horizon)."""
-    torque = bang_bang(MAX_TORQUE, [TORQUE_SWITCH])
-    brake = brake_schedule(ENGAGE_TIMES, RELEASE_TIMES)
+    torque = stepping.bang_bang(MAX_TORQUE, [TORQUE_SWITCH])
+    brake = stepping.brake_schedule(ENGAGE_TIMES, RELEASE_TIMES)
     bounds = sorted({0.0, *ENGAGE_TIMES, *RELEASE_TIMES, TORQUE_SWITCH, MANIPULATOR_HORIZON})
     return torque, brake, bounds
 
@@ -500,15 +486,15 @@ def manipulator_phases(dt: float) -> list[tuple[int, float, float]]:
             for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
 
 
-def manipulator_reference(ctx: Context) -> tuple[np.ndarray, dict[str, Any]]:
-    """The reference states (S, 4) at the sample times and its record (time, self-check)."""
+def manipulator_reference(ctx: Context) -> None:
+    """The reference states (S, 4) at the sample times into ``ctx``, with its record."""
     torque, brake, _ = manipulator_schedule()
     grid = SAMPLE_INTERVAL * np.arange(_steps(MANIPULATOR_HORIZON, SAMPLE_INTERVAL) + 1)
     states = []
     seconds = []
     for rtol, atol in ((REFERENCE_RTOL, REFERENCE_ATOL), (CHECK_RTOL, CHECK_ATOL)):
         start = time.perf_counter()
-        run = simulate_manipulator(None, [0.0, 0.0], [0.0, 0.0], torque, brake,
+        run = stepping.simulate_manipulator(None, [0.0, 0.0], [0.0, 0.0], torque, brake,
                                    MANIPULATOR_HORIZON, sample_times=grid, rtol=rtol, atol=atol)
         seconds.append(time.perf_counter() - start)
         states.append(np.hstack([run.q, run.u]))
@@ -518,7 +504,7 @@ def manipulator_reference(ctx: Context) -> tuple[np.ndarray, dict[str, Any]]:
               "sample_interval_s": SAMPLE_INTERVAL, "samples": int(grid.size)}
     ctx.log(f"manipulator reference: {seconds[0]:.2f} s, |rtol 1e-12 - rtol 1e-11| = "
             f"{record['self_difference']:.1e}")
-    return states[0], record
+    ctx.reference, ctx.references["manipulator"] = states[0], record
 
 
 def _state_errors(samples: np.ndarray, reference: np.ndarray) -> dict[str, float]:
@@ -527,13 +513,12 @@ def _state_errors(samples: np.ndarray, reference: np.ndarray) -> dict[str, float
     return {"error": float(difference.max()), "final_error": float(difference[-1].max())}
 
 
-def manipulator_moreau_jean(ctx: Context, reference: np.ndarray) -> list[dict[str, Any]]:
+def manipulator_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
     """Moreau-Jean points: one ``step_batch`` call per phase (timed), replayed per sample."""
     points = []
     for dt in ctx.config.manipulator_time_steps:
-        st = ctx.stepper(BlockableManipulator, None, dt)
         phases = manipulator_phases(dt)
-        run = Copies(st, np.zeros((1, 2)), np.zeros((1, 2)))
+        run = ctx.copies(models.BlockableManipulator, None, dt)
         stride = _steps(SAMPLE_INTERVAL, dt)
         wall, repeats, final = ctx.timed(partial(
             run.run, [(steps, [torque], [bound]) for steps, torque, bound in phases]))
@@ -546,34 +531,35 @@ def manipulator_moreau_jean(ctx: Context, reference: np.ndarray) -> list[dict[st
                 samples.append(run.state())
         points.append(point(
             ctx.log, "manipulator", "mj_enumerative", "dt", dt, wall, repeats, "mj_per_phase",
-            _state_errors(np.array(samples), reference),
+            _state_errors(np.array(samples), ctx.reference),
             replay_difference=float(np.abs(samples[-1] - final).max())))
     return points
 
 
-def manipulator_event_driven(ctx: Context, reference: np.ndarray) -> list[dict[str, Any]]:
+def manipulator_event_driven(ctx: Context) -> list[dict[str, Any]]:
     """Event-driven points at each rtol (sampling at the 4 ms grid included in the time)."""
     torque, brake, _ = manipulator_schedule()
-    grid = SAMPLE_INTERVAL * np.arange(reference.shape[0])
+    grid = SAMPLE_INTERVAL * np.arange(ctx.reference.shape[0])
     points = []
     for rtol in ctx.config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
         wall, repeats, trajectory = ctx.timed(partial(
-            simulate_manipulator, None, [0.0, 0.0], [0.0, 0.0], torque, brake,
+            stepping.simulate_manipulator, None, [0.0, 0.0], [0.0, 0.0], torque, brake,
             MANIPULATOR_HORIZON, sample_times=grid, **options))
+        errors = _state_errors(np.hstack([trajectory.q, trajectory.u]), ctx.reference)
         points.append(point(ctx.log, "manipulator", "event_driven", "rtol", rtol, wall, repeats,
-                            "ed", _state_errors(np.hstack([trajectory.q, trajectory.u]), reference),
-                            atol=options["atol"], rhs_evaluations=trajectory.num_rhs_evals))
+                            "ed", errors, atol=options["atol"],
+                            rhs_evaluations=trajectory.num_rhs_evals))
     return points
 
 
-def manipulator_mujoco(ctx: Context, reference: np.ndarray) -> list[dict[str, Any]]:
+def manipulator_mujoco(ctx: Context) -> list[dict[str, Any]]:
     """MuJoCo arm points per brake solref setting and dt."""
     points = []
     for series in ctx.config.mujoco_arm_series:
         for dt in ctx.config.mujoco_arm_time_steps:
             solref = None if series == "default" else (2.0 * dt, 1.0)
-            arm = MujocoArmRun(ctx.mujoco, dt, solref)
+            arm = mj.MujocoArmRun(ctx.mujoco, dt, solref)
             phases = [(steps, torque, bool(np.isinf(bound)))
                       for steps, torque, bound in manipulator_phases(dt)]
             wall, repeats, (final, _) = ctx.timed(partial(arm.simulate, phases))
@@ -581,20 +567,20 @@ def manipulator_mujoco(ctx: Context, reference: np.ndarray) -> list[dict[str, An
             assert samples is not None
             points.append(point(
                 ctx.log, "manipulator", f"mujoco_{series}", "dt", dt, wall, repeats,
-                "mujoco_per_phase", _state_errors(samples, reference),
+                "mujoco_per_phase", _state_errors(samples, ctx.reference),
                 replay_difference=float(np.abs(samples[-1] - final).max()), **arm.brake_settings))
     return points
 
 
 def diff_drive_run(ctx: Context, dt: float) -> tuple[Callable[[], np.ndarray], Copies]:
     """A zero-argument run of the robot's phases at dt (one call per phase), and its copies."""
-    run = Copies(ctx.stepper(DiffDriveRobot, None, dt), np.zeros((1, 5)), np.zeros((1, 5)))
+    run = ctx.copies(models.DiffDriveRobot, None, dt)
     return partial(run.run, [(_steps(duration, dt), tau, ())
                              for duration, tau in DIFF_DRIVE_PHASES]), run
 
 
-def diff_drive_moreau_jean(ctx: Context) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """Robot points against the fine-step reference, and the reference's record."""
+def diff_drive_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
+    """Robot points against the fine-step reference (its record into ``ctx.references``)."""
     dt_ref = ctx.config.diff_drive_reference_step
     reference_run, reference_copies = diff_drive_run(ctx, dt_ref)
     start = time.perf_counter()
@@ -614,7 +600,8 @@ def diff_drive_moreau_jean(ctx: Context) -> tuple[list[dict[str, Any]], dict[str
         points.append(point(ctx.log, "diff_drive", "mj_newton_ac", "dt", dt, wall, repeats,
                             "mj_per_phase", {"error": float(np.abs(final - reference).max())},
                             worst_solver_status=SolverStatus(copies.worst_status).name))
-    return points, record
+    ctx.references["diff_drive"] = record
+    return points
 
 
 def observed_order(points: Sequence[dict[str, Any]]) -> float | None:
@@ -624,6 +611,18 @@ def observed_order(points: Sequence[dict[str, Any]]) -> float | None:
         return None
     dts, errors = np.array(usable).T
     return float(np.polyfit(np.log(dts), np.log(errors), 1)[0])
+
+
+STUDIES = {
+    "ball": (("ball Moreau-Jean", ball_moreau_jean), ("ball event-driven", ball_event_driven),
+             ("ball MuJoCo", ball_mujoco)),
+    "slope": (("slope", slope_moreau_jean),),
+    "manipulator": (("manipulator Moreau-Jean", manipulator_moreau_jean),
+                    ("manipulator event-driven", manipulator_event_driven),
+                    ("manipulator MuJoCo", manipulator_mujoco)),
+    "diff_drive": (("diff-drive", diff_drive_moreau_jean),),
+}
+"""Scene -> (name, study) in the order they run (the manipulator's after its reference)."""
 
 
 def evaluate_targets(points: Sequence[dict[str, Any]]
@@ -666,17 +665,18 @@ def evaluate_targets(points: Sequence[dict[str, Any]]
     return targets, comparison
 
 
-def _section(ctx: Context, name: str, action: Callable[[], Any], fallback: Any) -> Any:
+def _section(ctx: Context, name: str, study: Callable[[Context], list[dict[str, Any]]]
+             ) -> list[dict[str, Any]]:
     """Run one study; on an exception note it (``main`` then exits with 1) and go on."""
     try:
-        return action()
+        return study(ctx)
     except Exception as error:  # noqa: BLE001 - one failed study must not lose the others
         message = f"{name} failed: {type(error).__name__}: {error}"
         ctx.notes.append(message)
         ctx.failed_sections.append(name)
         ctx.log(message)
         ctx.log(traceback.format_exc())
-        return fallback
+        return []
 
 
 def run(output: Path, quick: bool, log: Log | None = None,
@@ -686,7 +686,7 @@ def run(output: Path, quick: bool, log: Log | None = None,
     log = log or progress
     config = config or (QUICK if quick else FULL)
     output.mkdir(parents=True, exist_ok=True)
-    mujoco, mujoco_note = import_mujoco()
+    mujoco, mujoco_note = mj.import_mujoco()
     ctx = Context(config, log, mujoco)
     if mujoco_note:
         ctx.notes.append(mujoco_note)
@@ -697,34 +697,17 @@ def run(output: Path, quick: bool, log: Log | None = None,
     }
     log(f"work-precision benchmark ({'quick' if quick else 'full'}) -> {output}")
     points: list[dict[str, Any]] = []
-    references: dict[str, Any] = {}
-    calibrations: list[dict[str, Any]] = []
-    if "ball" in config.scenes:
-        points += _section(ctx, "ball Moreau-Jean", lambda: ball_moreau_jean(ctx), [])
-        points += _section(ctx, "ball event-driven", lambda: ball_event_driven(ctx), [])
-        if mujoco is not None:
-            mj_points, calibrations = _section(ctx, "ball MuJoCo", lambda: ball_mujoco(ctx),
-                                               ([], []))
-            points += mj_points
-    if "slope" in config.scenes:
-        points += _section(ctx, "slope", lambda: slope_moreau_jean(ctx), [])
-    if "manipulator" in config.scenes:
-        reference, references["manipulator"] = manipulator_reference(ctx)
-        for name, study in (("Moreau-Jean", manipulator_moreau_jean),
-                            ("event-driven", manipulator_event_driven),
-                            ("MuJoCo", manipulator_mujoco)):
-            if name != "MuJoCo" or mujoco is not None:
-                points += _section(ctx, f"manipulator {name}",
-                                   partial(study, ctx, reference), [])
-    if "diff_drive" in config.scenes:
-        dd_points, dd_reference = _section(ctx, "diff-drive",
-                                           lambda: diff_drive_moreau_jean(ctx), ([], None))
-        points += dd_points
-        if dd_reference is not None:
-            references["diff_drive"] = dd_reference
+    for scene, studies in STUDIES.items():
+        if scene not in config.scenes:
+            continue
+        if scene == "manipulator":
+            manipulator_reference(ctx)
+        for name, study in studies:
+            if "MuJoCo" not in name or mujoco is not None:
+                points += _section(ctx, name, study)
     targets, comparison = evaluate_targets(points)
-    record.update({"compile": ctx.compile, "points": points, "references": references,
-                   "mujoco_ball_calibration": calibrations,
+    record.update({"compile": ctx.compile, "points": points, "references": ctx.references,
+                   "mujoco_ball_calibration": ctx.calibrations,
                    "equal_time": comparison, "targets": targets, "notes": ctx.notes,
                    "failed_sections": ctx.failed_sections})
     timing.finish(record, progress.elapsed)
@@ -798,15 +781,13 @@ def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
         "min_lower_bound_ratio": min(bounds) if bounds else None,
         "ratio_at_1ms": None if at_1ms is None else at_1ms["ratio"],
     }
-    parts = []
-    if equal:
-        parts.append(f"at equal time (interpolated) {_format(min(equal))}–{_format(max(equal))}× "
-                     f"over {len(equal)} of our dt")
-    if bounds:
-        parts.append(f"where ours is faster than any MuJoCo run (clamped: lower bounds) "
-                     f"{_format(min(bounds))}–{_format(max(bounds))}× over {len(bounds)} of our dt")
+    parts = [f"{text} {format_number(min(ratios))}–{format_number(max(ratios))}× over "
+             f"{len(ratios)} of our dt" for text, ratios in (
+                 ("at equal time (interpolated)", equal),
+                 ("where ours is faster than any MuJoCo run (clamped: lower bounds)", bounds))
+             if ratios]
     if at_1ms is not None and at_1ms["ratio"] is not None:
-        parts.append(f"at dt = 1e-3: {_format(at_1ms['ratio'])}× ({at_1ms['how']})")
+        parts.append(f"at dt = 1e-3: {format_number(at_1ms['ratio'])}× ({at_1ms['how']})")
     result["summary"] = "; ".join(parts) or "no comparable point"
     return result
 
@@ -892,10 +873,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     record = run(args.output, args.quick)
     print(markdown_report(record))
     return 1 if record.get("failed_sections") else 0
-
-
-__all__ = ["FULL", "QUICK", "WorkPrecisionConfig", "ball_errors", "evaluate_targets", "main",
-           "observed_order", "run"]
 
 
 if __name__ == "__main__":
