@@ -8,9 +8,7 @@ interpreters, and writes the medians and ratios to ``before_after.json`` and ``.
 from __future__ import annotations
 
 import json
-import os
 import statistics
-import subprocess
 import sys
 import tempfile
 from collections.abc import Sequence
@@ -18,9 +16,8 @@ from pathlib import Path
 from typing import Any
 
 from benchmarks import report
-from benchmarks.timing import Progress, arguments, machine_info
+from benchmarks.timing import ROOT, Progress, arguments, fresh_python, machine_info
 
-ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = (("engine", "engine.json"), ("envs", "envs.json"))
 LIMIT = 1.10
 """An 'after' step may be at most this factor slower than 'before' (lower-is-better units)."""
@@ -30,10 +27,6 @@ def _targets(record: dict[str, Any]) -> dict[str, tuple[float, str]]:
     """{target: (measured, unit)} of a benchmark record's measured targets."""
     return {t["target"]: (float(t["measured"]), t["unit"]) for t in record.get("targets") or []
             if isinstance(t.get("measured"), (int, float))}
-
-
-def _lower_is_better(unit: str) -> bool:
-    return "/s" not in unit and "×" not in unit and "per s" not in unit
 
 
 ARGUMENTS = {"engine": ("--quick", "--models", "manipulator,diff_drive"), "envs": ("--quick",)}
@@ -48,9 +41,8 @@ def _run_in(tree: Path, scratch: Path, *args: str) -> str:
         for package in ("mdi_envs", "optimal", "baselines"):
             (harness / package).symlink_to(tree / package)
         (harness / "benchmarks").symlink_to(ROOT / "benchmarks")
-    process = subprocess.run([sys.executable, "-m", f"benchmarks.{args[0]}", *args[1:]],
-                             cwd=harness, env={**os.environ, "PYTHONPATH": str(harness)},
-                             capture_output=True, text=True, check=False)
+    process = fresh_python("-m", f"benchmarks.{args[0]}", *args[1:], cwd=harness,
+                           PYTHONPATH=str(harness))
     if process.returncode != 0:
         raise RuntimeError(f"benchmarks.{args[0]} on {tree} failed: "
                            f"{process.stderr.strip().splitlines()[-1:]}")
@@ -69,12 +61,6 @@ def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]
     return found
 
 
-def in_place_once(tree: Path, model: str, scratch: Path) -> tuple[float, float]:
-    """(min, median) µs of ``benchmarks.in_place_probe MODEL`` on the package in ``tree``."""
-    fastest, median = _run_in(tree, scratch, "in_place_probe", model).split()
-    return float(fastest), float(median)
-
-
 def run(before: Path, rounds: int, output: Path) -> str:
     """Alternate the trees ``rounds`` times, write the JSON and PNG, return the table."""
     log = Progress()
@@ -90,8 +76,9 @@ def run(before: Path, rounds: int, output: Path) -> str:
                         samples[label].setdefault(f"{name}: {target}", []).append(value)
                         units[f"{name}: {target}"] = unit
                 for model in ("manipulator", "diff_drive"):
-                    fastest, median = in_place_once(tree, model, Path(scratch))
-                    for statistic, value in (("min", fastest), ("median", median)):
+                    # (min, median) µs of the in-place probe on the package in ``tree``
+                    fastest, median = _run_in(tree, Path(scratch), "in_place_probe", model).split()
+                    for statistic, value in (("min", float(fastest)), ("median", float(median))):
                         key = (f"in-place probe: {model} InPlaceStepper.step(), {statistic} "
                                "over 300 batches")
                         samples[label].setdefault(key, []).append(value)
@@ -103,7 +90,8 @@ def run(before: Path, rounds: int, output: Path) -> str:
         old = statistics.median(samples["before"][target])
         new = statistics.median(samples["after"][target])
         unit = units[target]
-        slowdown = new / old if _lower_is_better(unit) else old / new
+        rate = "/s" in unit or "×" in unit or "per s" in unit  # higher is better
+        slowdown = old / new if rate else new / old
         rows.append({"target": target, "unit": unit, "before": old, "after": new,
                      "slowdown": slowdown, "ok": slowdown <= LIMIT,
                      "before_runs": samples["before"][target],

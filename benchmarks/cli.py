@@ -1,6 +1,6 @@
 """``mdi-envs bench [NAME ...] [--quick] [--skip NAME ...]``: the benchmark suite, one command.
 
-Each NAME runs one module's ``main`` into ``--output``; ``headline`` then tabulates the targets of
+Each NAME runs one module's ``main`` into ``--output``; the headline table then holds the targets of
 the results found there. Exit code 1 when a benchmark crashes or a stress case fails.
 Registered as the ``mdi_envs.commands`` entry point ``bench``; not installed with the package, it
 runs from the repository's root (``python -m mdi_envs bench``), whose results folder it writes.
@@ -56,7 +56,7 @@ def add_bench_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 def run_bench(args: argparse.Namespace) -> int:
     """Handler of ``bench``: runs the chosen benchmarks, then the headline table; exit code."""
-    from benchmarks.headline import write_headline
+    from benchmarks.report import write_headline
 
     names = [name for name in args.names or BENCHMARKS if name not in args.skip]
     unknown = [name for name in [*names, *args.skip] if name not in BENCHMARKS]

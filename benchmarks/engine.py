@@ -136,9 +136,6 @@ def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
     stepper.tau[:] = tau
     if brake is not None:
         stepper.brake_bound[:] = brake
-    stepper.step()
-    stepper.q[:] = q
-    stepper.u[:] = u
     step = stepper.step
     steps = range(IN_PLACE_STEPS_PER_CALL)
 
@@ -160,12 +157,10 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
         st = steppers[case.label]
         for scene in case.scenes:
             arrays = scene.arrays()
-            calls[f"{case.label}|{scene.name}|step"] = (
-                lambda st=st, a=arrays: st.step(*a))
+            calls[f"{case.label}|{scene.name}|step"] = lambda st=st, a=arrays: st.step(*a)
             calls[f"{case.label}|{scene.name}|in_place"] = _in_place_call(st, arrays)
-    if arm is not None:
-        for scene, call in arm.single_step_calls().items():
-            calls[f"mujoco|{scene}|mj_step"] = call
+    for scene, call in (arm.single_step_calls() if arm is not None else {}).items():
+        calls[f"mujoco|{scene}|mj_step"] = call
     log(f"single step: {len(calls)} callables, interleaved ...")
     timed = timing.time_interleaved(calls, config.single_plan)
     rows = []
@@ -257,13 +252,6 @@ def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
     return _per_copy_rows(entries, n, config.substep_plan, ("model",))
 
 
-def _state_difference(first: BatchedCall, second: BatchedCall) -> float:
-    """Largest |difference| of the states the two calls reach from the same initial states."""
-    first()
-    second()
-    return float(max(np.abs(first.q - second.q).max(), np.abs(first.u - second.u).max()))
-
-
 def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
                    config: EngineConfig, log: Progress, compile_records: list[dict]
                    ) -> list[dict[str, Any]]:
@@ -290,7 +278,10 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
                 log(f"  first step_batch {batch_s:.1f} s")
                 variants[key] = st
             off = BatchedCall(variants[key], on_arrays, on.num_substeps)
-            difference: float | None = _state_difference(on, off)
+            on()  # both from the same initial states: the largest |state difference|
+            off()
+            difference: float | None = float(max(np.abs(on.q - off.q).max(),
+                                                 np.abs(on.u - off.u).max()))
             off_scene = sc.scene
         else:
             off = _batched_entry(steppers[case.label],
@@ -419,12 +410,10 @@ def shortcuts_text(shortcuts: Any) -> str:
 
 
 def case_record(case: Any) -> dict[str, Any]:
-    """A model case (model, scenes, mix) as JSON-ready data."""
+    """A model case (model, scenes, mix) as JSON-ready data (an ideal brake's bound "inf")."""
     return {"label": case.label, "model": case.model.__name__,
             "mix": [s.name for s in case.mix_scenes],
-            "scenes": [{"name": s.name, "description": s.description, "q": s.q, "u": s.u,
-                        "tau": s.tau, "brake": [float(b) if np.isfinite(b) else "inf"
-                                                for b in s.brake]} for s in case.scenes]}
+            "scenes": report.json_safe([asdict(s) for s in case.scenes])}
 
 
 def markdown_report(record: Mapping[str, Any]) -> str:
@@ -443,16 +432,11 @@ def markdown_report(record: Mapping[str, Any]) -> str:
             "shortcut", "model", "scene", "off_scene", "on.per_copy_step_s",
             "off.per_copy_step_s", "speedup", "speedup_fastest_rounds",
             "max_state_difference"]),
-        "Brake stop (steps until the relative velocity < 1 % of 1 rad/s)": brake_rows(
-            record.get("brake_stop")),
+        "Brake stop (steps until the relative velocity < 1 % of 1 rad/s)": (
+            [{"simulator": key, **value} for key, value in record["brake_stop"].items()],
+            ["simulator", "steps", "relative_angle_at_stop", "solref",
+             "relative_speed_after_first_step"]),
     })
-
-
-def brake_rows(brake: Mapping[str, Any] | None) -> tuple[list[dict[str, Any]], list[str]]:
-    """The brake-stop study as table rows (simulator, steps, relative angle, solref)."""
-    rows = [{"simulator": key, **value} for key, value in (brake or {}).items()]
-    return rows, ["simulator", "steps", "relative_angle_at_stop", "solref",
-                  "relative_speed_after_first_step"]
 
 
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],

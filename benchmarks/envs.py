@@ -146,15 +146,10 @@ def _error_text(error: BaseException) -> str:
 def _make_single(env_id: str, ours: bool, seed: int, samples: int
                  ) -> tuple[dict[str, Any], list[Any]]:
     """Make the env twice (timed ``gym.make`` and unwrapped) and time the first calls."""
-    start = time.perf_counter()
-    env = gym.make(env_id)
-    make_s = time.perf_counter() - start
-    env.reset(seed=seed)
-    reset_s = time.perf_counter() - start - make_s
+    env, make_s = timing.timed_call(lambda: gym.make(env_id))
+    reset_s = timing.seconds(lambda: env.reset(seed=seed))
     actions = _sample_actions(env.action_space, samples, seed)
-    start = time.perf_counter()
-    env.step(actions[0])
-    first_step_s = time.perf_counter() - start
+    first_step_s = timing.seconds(lambda: env.step(actions[0]))
     env.reset(seed=seed)
     bare = gym.make(env_id).unwrapped
     bare.reset(seed=seed)

@@ -44,14 +44,6 @@ def time_solve(data: Any, method: str, options: dict[str, Any]) -> tuple[Any, fl
             return result, float(np.median(times))
 
 
-def warm_up() -> None:
-    """Compile (or load) every method's kernels outside the timed calls."""
-    W = np.eye(6) + 0.1
-    for method in METHODS:
-        solve_fc3d(W, np.array([-1.0, 0.5, 0.0, -1.0, 0.0, 2.0]), np.array([0.3, 0.3]),
-                   method=method)
-
-
 def run(output: Path, quick: bool) -> str:
     """Run every method on every peer problem, write the JSON and the plot, return the table."""
     log = Progress()
@@ -60,7 +52,9 @@ def run(output: Path, quick: bool) -> str:
     files = sorted(folder.glob("*.dat")) if folder.is_dir() else []
     if not files:
         log(f"peer data {folder} absent: nothing to run")
-    warm_up()
+    for method in METHODS:  # compile (or load) every method's kernels outside the timings
+        solve_fc3d(np.eye(6) + 0.1, np.array([-1.0, 0.5, 0.0, -1.0, 0.0, 2.0]),
+                   np.array([0.3, 0.3]), method=method)
     rows = []
     for path in files:
         data = read_friction_contact(path)

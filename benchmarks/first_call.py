@@ -14,10 +14,9 @@ def main() -> None:
         "mdi_envs.solvers.lcp": seconds(lambda: importlib.import_module("mdi_envs.solvers.lcp")),
         "quantecon.optimize": seconds(lambda: importlib.import_module("quantecon.optimize")),
     }
-    from benchmarks import entries
-    from benchmarks.problems import random_problem
+    from benchmarks import problems as entries
 
-    problem = random_problem("spd", 5, 0)
+    problem = entries.random_problem("spd", 5, 0)
     probes = [entries.KERNEL] + [entries.driver_entry(m) for m in entries.LCP_METHODS]
     probes.append(entries.QUANTECON)
     first_call = {e.name: seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}

@@ -1,7 +1,9 @@
-"""Benchmark problems: two seeded random LCP families and the Siconos peer LCP files.
+"""The LCP benchmark's problems and the solver entries under test.
 
-``spd``: ``M = A A^T / n + 0.1 I``; ``contact``: a redundant-contact Delassus matrix regularized
-as constraint-force mixing does. Every instance follows from ``(SEED, family, n, instance)``.
+Problems: two seeded random LCP families and the Siconos peer LCP files. ``spd``:
+``M = A A^T / n + 0.1 I``; ``contact``: a redundant-contact Delassus matrix regularized as
+constraint-force mixing does. Every instance follows from ``(SEED, family, n, instance)``.
+Entries: each timed on its bare call, its outcome read afterwards.
 """
 
 from __future__ import annotations
@@ -11,11 +13,16 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from quantecon.optimize import lcp_lemke
 
 from mdi_envs._types import FloatArray
+from mdi_envs.solvers.lcp import lcp_residual, solve_lcp
+from mdi_envs.solvers.lcp.lemke import LemkeOptions, lemke_solve
 from mdi_envs.solvers.siconos_io import read_lcp
+from mdi_envs.solvers.status import SolverStatus
 
 SEED = 20_240_601  # Root seed of every random benchmark problem.
 CONTACTS_PER_BODY = 6
@@ -89,3 +96,56 @@ def peer_lcp_problems(root: Path | None = None) -> list[Problem]:
         M, q = read_lcp(path)
         problems.append(Problem(path.stem, "siconos", q.shape[0], np.ascontiguousarray(M), q))
     return problems
+
+LCP_METHODS = ("lemke", "pgs", "newton_fb", "enumerative")  # of solve_lcp, in the size study
+ENUMERATIVE_MAX_N = 10  # largest n of the exhaustive method (2^n index sets)
+QUANTECON_MAX_ITER = 10_000  # QuantEcon's pivot cap (its default 10^6 cycles on lcp_tobenna)
+QUANTECON_STATUS = {0: "0 (solved)", 1: "1 (iteration limit)", 2: "2 (secondary ray)"}
+_LEMKE = LemkeOptions()
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """A solve's own success flag and status, its iterations and the shared residual measure."""
+
+    success: bool
+    status: str
+    iterations: int
+    residual: float
+
+
+@dataclass(frozen=True)
+class Entry:
+    """A timed ``solve(M, q)`` and ``read(raw, M, q) -> Outcome`` of its raw result."""
+
+    name: str
+    label: str
+    solve: Callable[[FloatArray, FloatArray], Any]
+    read: Callable[[Any, FloatArray, FloatArray], Outcome]
+
+
+def driver_entry(method: str) -> Entry:
+    """The public driver ``solve_lcp(M, q, method=method)`` (validation + residual included)."""
+    return Entry(method, f"solve_lcp(method={method!r})",
+                 lambda M, q: solve_lcp(M, q, method=method),
+                 lambda r, M, q: Outcome(r.status is SolverStatus.CONVERGED, r.status.name,
+                                         int(r.num_iter), float(r.residual)))
+
+
+def _kernel_read(raw: Any, M: FloatArray, q: FloatArray) -> Outcome:
+    z, code, pivots = raw
+    status = SolverStatus(code)
+    return Outcome(status is SolverStatus.CONVERGED, status.name, int(pivots),
+                   lcp_residual(M, q, z))
+
+
+KERNEL = Entry("lemke_solve", "lemke_solve (compiled entry)",
+               lambda M, q: lemke_solve(M, q, _LEMKE.max_iter, _LEMKE.pivot_tol, _LEMKE.tie_tol,
+                                        _LEMKE.tol), _kernel_read)
+QUANTECON = Entry("quantecon", "quantecon.optimize.lcp_lemke (compiled)",
+                  lambda M, q: lcp_lemke(M, q, max_iter=QUANTECON_MAX_ITER),
+                  lambda r, M, q: Outcome(bool(r.success),
+                                          QUANTECON_STATUS.get(int(r.status), str(r.status)),
+                                          int(r.num_iter), lcp_residual(M, q, r.z)))
+DRIVER_LEMKE = driver_entry("lemke")
+

@@ -15,15 +15,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from benchmarks import entries as E
+from benchmarks import problems as E
 from benchmarks import report, timing
-from benchmarks.problems import (
-    FAMILIES,
-    Problem,
-    peer_data_dir,
-    peer_lcp_problems,
-    random_problem,
-)
 from benchmarks.report import bars, log_lines, plt, save_figure, summary
 from benchmarks.timing import Progress, TimingPlan
 
@@ -70,12 +63,12 @@ def measure_first_calls(config: BenchConfig, log: Progress) -> dict[str, Any]:
 
 def warm_up(all_entries: Sequence[E.Entry]) -> None:
     """Call every entry once in this process so no timed call includes a compile or cache load."""
-    problem = random_problem("spd", 5, 0)
+    problem = E.random_problem("spd", 5, 0)
     for entry in all_entries:
         entry.solve(problem.M, problem.q)
 
 
-def time_problem(problem: Problem, chosen: Sequence[E.Entry], plan: TimingPlan) -> dict[str, Any]:
+def time_problem(problem: E.Problem, chosen: Sequence[E.Entry], plan: TimingPlan) -> dict[str, Any]:
     """Time entries on one problem in interleaved rounds and read their outcomes."""
     calls = {e.name: (lambda e=e: e.solve(problem.M, problem.q)) for e in chosen}
     timed = timing.time_interleaved(calls, plan)
@@ -91,11 +84,11 @@ def time_problem(problem: Problem, chosen: Sequence[E.Entry], plan: TimingPlan) 
 def size_study(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
     """Every method on every (family, n, instance) of the grid; one record per entry."""
     records = []
-    for family in FAMILIES:
+    for family in E.FAMILIES:
         for n in config.sizes:
             latest = [{"family": family, "n": n, "instance": i, "entry": name, **measured}
                       for i in range(config.instances) for name, measured in time_problem(
-                          random_problem(family, n, i), E.size_study_entries(n),
+                          E.random_problem(family, n, i), size_study_entries(n),
                           config.size_plan).items()]
             records += latest
             log(f"size study {family} n={n}: " + ", ".join(
@@ -104,26 +97,32 @@ def size_study(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
     return records
 
 
-def comparison_problems(config: BenchConfig, log: Progress) -> list[Problem]:
+def size_study_entries(n: int) -> list[E.Entry]:
+    """The driver methods applicable at size n, plus QuantEcon's Lemke for reference."""
+    return [E.driver_entry(m) for m in E.LCP_METHODS
+            if m != "enumerative" or n <= E.ENUMERATIVE_MAX_N] + [E.QUANTECON]
+
+
+def comparison_problems(config: BenchConfig, log: Progress) -> list[E.Problem]:
     """The Siconos peer LCP files (if present) and the random problems n = 10, 20, ..., 100."""
-    peers = peer_lcp_problems()
-    log(f"peer data: {len(peers)} LCP files from {peer_data_dir() / 'lcp'}" if peers else
-        f"peer data: {peer_data_dir() / 'lcp'} absent; skipping the Siconos files (set "
+    peers = E.peer_lcp_problems()
+    log(f"peer data: {len(peers)} LCP files from {E.peer_data_dir() / 'lcp'}" if peers else
+        f"peer data: {E.peer_data_dir() / 'lcp'} absent; skipping the Siconos files (set "
         "MDI_ENVS_PEER_DATA to the siconos folder to include them)")
-    return peers + [random_problem(f, n, i) for f in FAMILIES for n in config.peer_sizes
+    return peers + [E.random_problem(f, n, i) for f in E.FAMILIES for n in config.peer_sizes
                     for i in range(config.peer_instances)]
 
 
 FIXED_COST_PROBLEMS = (
-    Problem("2x2, two pivots", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
+    E.Problem("2x2, two pivots", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
             np.array([-5.0, -6.0])),
-    Problem("2x2, q >= 0", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
+    E.Problem("2x2, q >= 0", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
             np.array([1.0, 2.0])),
 )
 """n = 2 problems on which a call's time is almost all fixed cost (dispatch, checks, result)."""
 
 
-def compare_lemke(problems: Sequence[Problem], plan: TimingPlan, log: Progress
+def compare_lemke(problems: Sequence[E.Problem], plan: TimingPlan, log: Progress
                   ) -> list[dict[str, Any]]:  # fmt: skip
     """Our Lemke (driver and compiled entry) against QuantEcon's, interleaved, per problem."""
     keys = {"driver": E.DRIVER_LEMKE, "kernel": E.KERNEL, "quantecon": E.QUANTECON}

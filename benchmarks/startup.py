@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -21,7 +20,7 @@ from typing import Any
 
 from benchmarks import report
 from benchmarks.startup_probe import FLOOR
-from benchmarks.timing import Progress, arguments, machine_info
+from benchmarks.timing import Progress, arguments, fresh_python, machine_info
 
 REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
 """Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
@@ -30,26 +29,20 @@ ENTRIES = ("single", "vector", "subproc")
 QUICK_IDS = ("mdi_envs/BlockableManipulator-v1", "Acrobot-v1")
 """The ids ``--quick`` probes (warm, once, gym.make and gym.make_vec), besides the floor."""
 TARGET_RATIO = 2.0  # Warm start-up target: within this factor of Acrobot-v1's, entry by entry.
-ROOT = Path(__file__).resolve().parents[1]
 
 
-def _environment(cache: Path | None, python_path: Path | None) -> dict[str, str]:
-    environment = dict(os.environ)
-    if cache is not None:
-        environment["MDI_ENVS_CACHE_DIR"] = str(cache)
-    if python_path is not None:
-        environment["PYTHONPATH"] = str(python_path)
-    return environment
+def _paths(cache: Path | None, python_path: Path | None) -> dict[str, str | None]:
+    """The kernel cache and PYTHONPATH of a fresh interpreter (None: as in this one)."""
+    return {"MDI_ENVS_CACHE_DIR": None if cache is None else str(cache),
+            "PYTHONPATH": None if python_path is None else str(python_path)}
 
 
 def time_to_first_step(entry: str, env_id: str, cache: Path | None,
                        python_path: Path | None = None) -> dict[str, Any]:
     """Seconds from starting a fresh interpreter to its first ``step`` returned, and phases."""
     started = time.time()
-    process = subprocess.run(
-        [sys.executable, "-m", "benchmarks.startup_probe", entry, env_id], cwd=ROOT,
-        env=_environment(cache, python_path), capture_output=True, text=True, check=False,
-    )
+    process = fresh_python("-m", "benchmarks.startup_probe", entry, env_id,
+                           **_paths(cache, python_path))
     lines = [line for line in process.stdout.splitlines() if line.startswith("{")]
     if process.returncode != 0 or not lines:
         return {"error": (process.stderr.strip().splitlines() or ["no output"])[-1]}
@@ -60,12 +53,8 @@ def time_to_first_step(entry: str, env_id: str, cache: Path | None,
 def compile_all(cache: Path | None, python_path: Path | None = None) -> dict[str, Any]:
     """Wall seconds of ``mdi-envs compile all`` in a fresh interpreter, and its exit code."""
     started = time.perf_counter()
-    process = subprocess.run(
-        [sys.executable, "-c", "import sys; from mdi_envs.cli import main; "
-         "sys.exit(main(['compile', 'all']))"],
-        cwd=ROOT, env=_environment(cache, python_path), capture_output=True, text=True,
-        check=False,
-    )
+    process = fresh_python("-c", "import sys; from mdi_envs.cli import main; "
+                           "sys.exit(main(['compile', 'all']))", **_paths(cache, python_path))
     return {"seconds": time.perf_counter() - started, "returncode": process.returncode,
             "output": process.stdout.strip().splitlines()[-6:]}
 

@@ -59,8 +59,8 @@ class Timed:
                 "number": self.number}
 
 
-def _timed_call(call: Callable[[], Any]) -> tuple[Any, float]:
-    """Call once; return (result, seconds)."""
+def timed_call(call: Callable[[], Any]) -> tuple[Any, float]:
+    """Call once; return (result, wall-clock seconds)."""
     start = time.perf_counter()
     result = call()
     return result, time.perf_counter() - start
@@ -72,7 +72,7 @@ def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -
     Each gets one untimed warm-up call, then per round a batch of ``number`` calls lasting at
     least ``plan.min_batch_s``; the time per call is the median over rounds of batch / number.
     """
-    warm = {name: _timed_call(call) for name, call in calls.items()}
+    warm = {name: timed_call(call) for name, call in calls.items()}
     numbers = {name: max(1, math.ceil(plan.min_batch_s / max(seconds, 1e-9)))
                for name, (_, seconds) in warm.items()}
     slowest = max(numbers[name] * warm[name][1] for name in calls)
@@ -87,16 +87,24 @@ def time_interleaved(calls: Mapping[str, Callable[[], Any]], plan: TimingPlan) -
                         rounds, numbers[name]) for name, q in quartiles.items()}
 
 
+ROOT = Path(__file__).resolve().parents[1]
+"""The repository's root, where ``python -m benchmarks.NAME`` runs."""
+
+
+def fresh_python(*args: str, cwd: Path = ROOT, **env: str | None
+                 ) -> subprocess.CompletedProcess[str]:  # fmt: skip
+    """``python ARGS`` in a fresh interpreter in ``cwd``, ``env`` (but None) over this one's."""
+    environment = {**os.environ, **{key: value for key, value in env.items() if value is not None}}
+    return subprocess.run([sys.executable, *args], cwd=cwd, env=environment, capture_output=True,
+                          text=True, check=False)
+
+
 def probe_first_calls(cold: bool) -> dict[str, Any]:
     """Run ``benchmarks.first_call`` in a fresh interpreter and return its JSON report."""
-    env = dict(os.environ)
     with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache_dir:
-        if cold:  # numba's cache for other code, the package's own (mdi_envs._kernel_cache)
-            env["NUMBA_CACHE_DIR"] = cache_dir
-            env["MDI_ENVS_CACHE_DIR"] = cache_dir
-        process = subprocess.run([sys.executable, "-m", "benchmarks.first_call"],
-                                 cwd=Path(__file__).resolve().parents[1], env=env,
-                                 capture_output=True, text=True, check=False)
+        cache = cache_dir if cold else None  # numba's cache, and the package's own
+        process = fresh_python("-m", "benchmarks.first_call", NUMBA_CACHE_DIR=cache,
+                               MDI_ENVS_CACHE_DIR=cache)
     if process.returncode != 0:
         return {"error": process.stderr.strip().splitlines()[-1:]}
     return json.loads(process.stdout)
@@ -145,7 +153,7 @@ def speed_probe(samples: int = 200, number: int = 5000) -> dict[str, float]:
 
 def seconds(action: Callable[[], Any]) -> float:
     """Wall-clock seconds of one call of ``action()``."""
-    return _timed_call(action)[1]
+    return timed_call(action)[1]
 
 
 def _version(name: str) -> str | None:

@@ -28,16 +28,14 @@ def make_backend(backend: str, env_id: str, num_envs: int, env_kwargs: dict[str,
 
     from baselines.vec_env import make_vec_env
 
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
     if backend == "batched adapter":
         return VecMonitor(make_vec_env(env_id, num_envs, **env_kwargs))
-    if backend == "DummyVecEnv":
-        return sb3_make_vec_env(env_id, num_envs, seed=0, env_kwargs=env_kwargs,
-                                vec_env_cls=DummyVecEnv)  # fmt: skip
-    if backend == "SubprocVecEnv":
-        return sb3_make_vec_env(env_id, num_envs, seed=0, env_kwargs=env_kwargs,
-                                vec_env_cls=SubprocVecEnv,
-                                vec_env_kwargs={"start_method": "fork"})  # fmt: skip
-    raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
+    subproc = backend == "SubprocVecEnv"
+    return sb3_make_vec_env(env_id, num_envs, seed=0, env_kwargs=env_kwargs,
+                            vec_env_cls=SubprocVecEnv if subproc else DummyVecEnv,
+                            vec_env_kwargs={"start_method": "fork"} if subproc else None)
 
 
 def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str, Any]:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 import textwrap
-import time
 import traceback
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -230,11 +229,6 @@ def _steps(duration: float, dt: float) -> int:
     return steps
 
 
-def drop_gaps(count: int) -> np.ndarray:
-    """The ball ensemble's initial gaps h0 [m], (count,), U(0.9, 1.1) with seed 0."""
-    return np.random.default_rng(0).uniform(0.9, 1.1, count)
-
-
 def ball_closed_form(p: BouncingBallParameters, gap: float) -> tuple[np.ndarray, np.ndarray]:
     """(apex gaps eps^(2k) h0 [m], k = 1..BOUNCES; impact times [s] of impacts 1..BOUNCES+1)."""
     eps, t1 = p.restitution, math.sqrt(2.0 * gap / p.gravity)
@@ -316,7 +310,9 @@ def ball_event_errors(p: BouncingBallParameters, gaps: np.ndarray, runs: list[Tr
 def _ball_setup(ctx: Context) -> tuple[BouncingBallParameters, WorkPrecisionConfig, np.ndarray,
                                       float]:
     """The ball's parameters, the run's configuration, the drops' gaps [m] and the horizon [s]."""
-    p, gaps = BouncingBallParameters(), drop_gaps(ctx.config.ball_drops)
+    # the drops' initial gaps h0 [m], U(0.9, 1.1) with seed 0
+    p, gaps = BouncingBallParameters(), np.random.default_rng(0).uniform(0.9, 1.1,
+                                                                         ctx.config.ball_drops)
     return p, ctx.config, gaps, ball_horizon(p, gaps)
 
 
@@ -424,12 +420,8 @@ def stick_slip_closed_form(theta: float, mu: float, mass: float, rate: float, gr
 
 def slope_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
     """Slope points: per method, case and dt (see the module docstring)."""
-    points = []
-    for method in ctx.config.methods:
-        for case in ("sliding", "sticking", "stick_slip"):
-            for dt in ctx.config.slope_time_steps:
-                points.append(_slope_point(ctx, method, case, dt))
-    return points
+    return [_slope_point(ctx, method, case, dt) for method in ctx.config.methods
+            for case in ("sliding", "sticking", "stick_slip") for dt in ctx.config.slope_time_steps]
 
 
 def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, Any]:
@@ -490,14 +482,12 @@ def manipulator_reference(ctx: Context) -> None:
     """The reference states (S, 4) at the sample times into ``ctx``, with its record."""
     torque, brake, _ = manipulator_schedule()
     grid = SAMPLE_INTERVAL * np.arange(_steps(MANIPULATOR_HORIZON, SAMPLE_INTERVAL) + 1)
-    states = []
-    seconds = []
-    for rtol, atol in ((REFERENCE_RTOL, REFERENCE_ATOL), (CHECK_RTOL, CHECK_ATOL)):
-        start = time.perf_counter()
-        run = stepping.simulate_manipulator(None, [0.0, 0.0], [0.0, 0.0], torque, brake,
-                                   MANIPULATOR_HORIZON, sample_times=grid, rtol=rtol, atol=atol)
-        seconds.append(time.perf_counter() - start)
-        states.append(np.hstack([run.q, run.u]))
+    runs = [timing.timed_call(partial(
+        stepping.simulate_manipulator, None, [0.0, 0.0], [0.0, 0.0], torque, brake,
+        MANIPULATOR_HORIZON, sample_times=grid, rtol=rtol, atol=atol))
+        for rtol, atol in ((REFERENCE_RTOL, REFERENCE_ATOL), (CHECK_RTOL, CHECK_ATOL))]
+    states = [np.hstack([run.q, run.u]) for run, _ in runs]
+    seconds = [elapsed for _, elapsed in runs]
     record = {"rtol": REFERENCE_RTOL, "atol": REFERENCE_ATOL, "wall_time_s": seconds[0],
               "check_rtol": CHECK_RTOL, "check_atol": CHECK_ATOL,
               "self_difference": float(np.abs(states[0] - states[1]).max()),
@@ -583,9 +573,7 @@ def diff_drive_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
     """Robot points against the fine-step reference (its record into ``ctx.references``)."""
     dt_ref = ctx.config.diff_drive_reference_step
     reference_run, reference_copies = diff_drive_run(ctx, dt_ref)
-    start = time.perf_counter()
-    reference = reference_run()
-    seconds = time.perf_counter() - start
+    reference, seconds = timing.timed_call(reference_run)
     check = diff_drive_run(ctx, 2.0 * dt_ref)[0]()
     record = {"time_step": dt_ref, "check_time_step": 2.0 * dt_ref, "wall_time_s": seconds,
               "self_difference": float(np.abs(reference - check).max()),
@@ -858,12 +846,11 @@ def plot_all(points: Sequence[Mapping[str, Any]], scenes: Sequence[str], output:
     names = []
     for scene in scenes:
         chosen = [p for p in points if p["scene"] == scene]
-        name = f"work_precision_{scene}.png"
-        plot_scene(chosen, scene, output / name)
-        names.append(name)
+        plot_scene(chosen, scene, output / f"work_precision_{scene}.png")
+        names.append(f"work_precision_{scene}.png")
         if scene == "ball":
-            plot_ball_convergence(chosen, output / "work_precision_ball_convergence.png")
             names.append("work_precision_ball_convergence.png")
+            plot_ball_convergence(chosen, output / names[-1])
     return names
 
 
