@@ -18,19 +18,11 @@ from typing import Any
 from benchmarks import report
 from benchmarks.timing import ROOT, Progress, arguments, fresh_python, machine_info
 
-BENCHMARKS = (("engine", "engine.json"), ("envs", "envs.json"))
 LIMIT = 1.10
 """An 'after' step may be at most this factor slower than 'before' (lower-is-better units)."""
-
-
-def _targets(record: dict[str, Any]) -> dict[str, tuple[float, str]]:
-    """{target: (measured, unit)} of a benchmark record's measured targets."""
-    return {t["target"]: (float(t["measured"]), t["unit"]) for t in record.get("targets") or []
-            if isinstance(t.get("measured"), (int, float))}
-
-
 ARGUMENTS = {"engine": ("--quick", "--models", "manipulator,diff_drive"), "envs": ("--quick",)}
-"""Each benchmark's arguments: quick budgets; the engine on both mission models."""
+"""The benchmarks run (each writes NAME.json) with their arguments: quick budgets; the engine on
+both mission models."""
 
 
 def _run_in(tree: Path, scratch: Path, *args: str) -> str:
@@ -49,53 +41,54 @@ def _run_in(tree: Path, scratch: Path, *args: str) -> str:
     return process.stdout
 
 
-def run_once(tree: Path, name: str, folder: Path) -> dict[str, tuple[float, str]]:
-    """Run ``benchmarks.<name>`` (``ARGUMENTS``) on the package in ``tree``; its targets."""
-    _run_in(tree, folder.parent, name, *ARGUMENTS[name], "--output", str(folder))
-    filename = dict(BENCHMARKS)[name]
-    record = json.loads((folder / filename).read_text())
-    found = _targets(record)
-    probe = (record.get("machine") or {}).get("speed_probe_at_start") or {}
-    if "median_us" in probe:  # the VM's phase at the run's start (benchmarks.timing)
-        found["speed probe at start (compiled no-op call, median)"] = (probe["median_us"], "µs")
+def run_once(tree: Path, scratch: Path, log: Progress) -> dict[str, tuple[float, str]]:
+    """{target: (value, unit)} of one round on the package in ``tree``.
+
+    Each benchmark's measured targets and its speed probe at the start (the VM's phase), then
+    the in-place probes.
+    """
+    found = {}
+    for name, options in ARGUMENTS.items():
+        log(f"{name} on {tree}")
+        folder = Path(tempfile.mkdtemp(dir=scratch))
+        _run_in(tree, scratch, name, *options, "--output", str(folder))
+        record = json.loads((folder / f"{name}.json").read_text())
+        probe = {"target": "speed probe at start (compiled no-op call, median)", "unit": "µs",
+                 "measured": (record["machine"].get("speed_probe_at_start") or {}).get("median_us")}
+        found.update({f"{name}: {t['target']}": (float(t["measured"]), t["unit"])
+                      for t in [*(record.get("targets") or []), probe]
+                      if isinstance(t.get("measured"), (int, float))})
+    for model in ("manipulator", "diff_drive"):  # (min, median) µs of the in-place probe
+        fastest, median = _run_in(tree, scratch, "in_place_probe", model).split()
+        for statistic, value in (("min", fastest), ("median", median)):
+            found[f"in-place probe: {model} InPlaceStepper.step(), {statistic} over 300 "
+                  "batches"] = (float(value), "µs")
     return found
 
 
 def run(before: Path, rounds: int, output: Path) -> str:
     """Alternate the trees ``rounds`` times, write the JSON and PNG, return the table."""
     log = Progress()
-    samples: dict[str, dict[str, list[float]]] = {"before": {}, "after": {}}
+    samples: dict[str, dict[str, list[float]]] = {}  # target -> label -> values
     units: dict[str, str] = {}
     with tempfile.TemporaryDirectory(prefix="before-after-") as scratch:
         for round_index in range(rounds):
             for label, tree in (("before", before), ("after", ROOT)):
-                for name, _ in BENCHMARKS:
-                    log(f"round {round_index + 1}/{rounds}: {name} on {label} ({tree})")
-                    folder = Path(scratch) / f"{label}-{name}-{round_index}"
-                    for target, (value, unit) in run_once(tree, name, folder).items():
-                        samples[label].setdefault(f"{name}: {target}", []).append(value)
-                        units[f"{name}: {target}"] = unit
-                for model in ("manipulator", "diff_drive"):
-                    # (min, median) µs of the in-place probe on the package in ``tree``
-                    fastest, median = _run_in(tree, Path(scratch), "in_place_probe", model).split()
-                    for statistic, value in (("min", float(fastest)), ("median", float(median))):
-                        key = (f"in-place probe: {model} InPlaceStepper.step(), {statistic} "
-                               "over 300 batches")
-                        samples[label].setdefault(key, []).append(value)
-                        units[key] = "µs"
+                log(f"round {round_index + 1}/{rounds}, {label}:")
+                for target, (value, unit) in run_once(tree, Path(scratch), log).items():
+                    samples.setdefault(target, {"before": [], "after": []})[label].append(value)
+                    units[target] = unit
     rows = []
-    for target in samples["after"]:
-        if target not in samples["before"]:
+    for target, runs in samples.items():
+        if not (runs["before"] and runs["after"]):
             continue
-        old = statistics.median(samples["before"][target])
-        new = statistics.median(samples["after"][target])
+        old, new = (statistics.median(runs[label]) for label in ("before", "after"))
         unit = units[target]
         rate = "/s" in unit or "×" in unit or "per s" in unit  # higher is better
         slowdown = old / new if rate else new / old
         rows.append({"target": target, "unit": unit, "before": old, "after": new,
-                     "slowdown": slowdown, "ok": slowdown <= LIMIT,
-                     "before_runs": samples["before"][target],
-                     "after_runs": samples["after"][target]})
+                     "slowdown": slowdown, "ok": slowdown <= LIMIT, "before_runs": runs["before"],
+                     "after_runs": runs["after"]})
     record = {"machine": machine_info(), "before_tree": str(before), "rounds": rounds,
               "limit": LIMIT, "rows": rows}
     output.mkdir(parents=True, exist_ok=True)

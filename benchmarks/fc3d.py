@@ -77,11 +77,10 @@ def run(output: Path, quick: bool) -> str:
               "solved_by_method": solved, "solved_by_any": sum(r["solved"] for r in rows),
               "run_time_s": log.elapsed}
     report.write_json(record, output / "fc3d.json")
-    if not rows:  # no peer data here: nothing to draw (a log axis of no values fails)
-        log(f"done in {log.elapsed:.0f} s; wrote fc3d.json (no problems) to {output}")
-        return markdown(record)
-    plot(rows, output / "fc3d.png")
-    log(f"done in {log.elapsed:.0f} s; wrote fc3d.json and fc3d.png to {output}")
+    if rows:  # without peer data nothing is drawn (a log axis of no values fails)
+        plot(rows, output / "fc3d.png")
+    log(f"done in {log.elapsed:.0f} s; wrote fc3d.json"
+        f"{' and fc3d.png' if rows else ' (no problems)'} to {output}")
     return markdown(record)
 
 

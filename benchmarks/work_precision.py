@@ -363,11 +363,9 @@ def ball_mujoco(ctx: Context) -> list[dict[str, Any]]:
     for series in config.mujoco_ball_series:
         for dt in config.mujoco_ball_time_steps:
             name = f"mujoco_{series}"
-            if series == "formula":
-                dampratio: float | None = mj.formula_dampratio(p.restitution)
-                note = "damped-oscillator formula"
-            else:
-                dampratio, note = mj.calibrate_dampratio(ctx.mujoco, p, dt)
+            dampratio, note = ((mj.formula_dampratio(p.restitution), "damped-oscillator formula")
+                               if series == "formula" else
+                               mj.calibrate_dampratio(ctx.mujoco, p, dt))
             if dampratio is None:
                 points.append(point(ctx.log, "ball", name, "dt", dt, None, 0, "",
                                     {"error": math.nan}, status=f"failed: {note}"))
