@@ -126,6 +126,15 @@ def target_row(name: str, comparison: str, threshold: float | None, unit: str,
             "measured": measured, "met": met, "note": note}
 
 
+def target_value(value: float | None, unit: str) -> str:
+    """A target's value with its unit, ratios as ``12.3×``."""
+    if value is None:
+        return "–"
+    if unit == "×":
+        return f"{value:.3g}×"
+    return f"{format_number(value)} {unit}".strip()
+
+
 def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
     """Markdown: target, threshold, measured, met (✓, ✗, ``–`` undecided, not measured), note."""
     def threshold(t: Mapping[str, Any]) -> str:
@@ -136,8 +145,7 @@ def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
 
     return markdown_table([{
         "target": t["target"], "threshold": threshold(t),
-        "measured": "–" if t["measured"] is None else f"{t['measured']:.3g}×" if t["unit"] == "×"
-        else f"{format_number(t['measured'])} {t['unit']}".strip(),
+        "measured": target_value(t["measured"], t["unit"]),
         "met": {True: "✓", False: "✗"}.get(t["met"], "–" if t["measured"] is not None
                                             else "not measured"),
         "note": t["note"]} for t in targets])  # fmt: skip
@@ -176,8 +184,8 @@ def write_json(record: dict[str, Any], path: Path) -> None:
     path.write_text(json.dumps(record, indent=1, default=lambda v: v.item()) + "\n")
 
 HEADLINE_SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
-           ("precision", "work_precision.json"), ("stress", "stress.json"),
-           ("startup", "startup.json"), ("control", "control.json"))  # fmt: skip
+                    ("precision", "work_precision.json"), ("stress", "stress.json"),
+                    ("startup", "startup.json"), ("control", "control.json"))  # fmt: skip
 """(benchmark name, result file) whose targets enter the table, in this order."""
 
 
