@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import textwrap
 import traceback
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from functools import partial
 from pathlib import Path
@@ -316,10 +316,9 @@ def _ball_setup(ctx: Context) -> tuple[BouncingBallParameters, WorkPrecisionConf
     return p, ctx.config, gaps, ball_horizon(p, gaps)
 
 
-def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
+def ball_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
     """Moreau-Jean ball points: per method and dt, drop 0 timed, D drops replayed step by step."""
     p, config, gaps, horizon = _ball_setup(ctx)
-    points = []
     variants = [(f"mj_{method}", method, False) for method in config.methods]
     for series, method, locate_impacts in [*variants, ("mj_located", "enumerative", True)]:
         for dt in config.ball_time_steps:
@@ -335,31 +334,28 @@ def ball_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
             for k in range(1, num_steps + 1):
                 replay.advance(1)
                 y[:, k], v[:, k] = replay.q[:, 1], replay.u[:, 1]
-            points.append(point(ctx.log, "ball", series, "dt", dt, wall, repeats, "mj_one_call",
-                                ball_errors(p, gaps, y, v, dt),
-                                replay_difference=float(np.abs(replay.state() - final).max())))
-    return points
+            yield point(ctx.log, "ball", series, "dt", dt, wall, repeats, "mj_one_call",
+                        ball_errors(p, gaps, y, v, dt),
+                        replay_difference=float(np.abs(replay.state() - final).max()))
 
 
-def ball_event_driven(ctx: Context) -> list[dict[str, Any]]:
+def ball_event_driven(ctx: Context) -> Iterator[dict[str, Any]]:
     """Event-driven ball points: per rtol, drop 0 timed, every drop's events compared."""
     p, config, gaps, horizon = _ball_setup(ctx)
-    points = []
     for rtol in config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
         wall, repeats, _ = ctx.timed(partial(stepping.simulate_ball, p, p.radius + gaps[0], horizon,
                                              **options))
         runs = [stepping.simulate_ball(p, p.radius + gap, horizon, **options) for gap in gaps]
-        points.append(point(ctx.log, "ball", "event_driven", "rtol", rtol, wall, repeats, "ed",
-                            ball_event_errors(p, gaps, runs), atol=options["atol"],
-                            rhs_evaluations=runs[0].num_rhs_evals))
-    return points
+        yield point(ctx.log, "ball", "event_driven", "rtol", rtol, wall, repeats, "ed",
+                    ball_event_errors(p, gaps, runs), atol=options["atol"],
+                    rhs_evaluations=runs[0].num_rhs_evals)
 
 
-def ball_mujoco(ctx: Context) -> list[dict[str, Any]]:
+def ball_mujoco(ctx: Context) -> Iterator[dict[str, Any]]:
     """MuJoCo ball points per dampratio mapping and dt (the calibrations into ``ctx``)."""
     p, config, gaps, horizon = _ball_setup(ctx)
-    points, calibrations = [], []
+    calibrations = []
     for series in config.mujoco_ball_series:
         for dt in config.mujoco_ball_time_steps:
             name = f"mujoco_{series}"
@@ -367,8 +363,8 @@ def ball_mujoco(ctx: Context) -> list[dict[str, Any]]:
                                if series == "formula" else
                                mj.calibrate_dampratio(ctx.mujoco, p, dt))
             if dampratio is None:
-                points.append(point(ctx.log, "ball", name, "dt", dt, None, 0, "",
-                                    {"error": math.nan}, status=f"failed: {note}"))
+                yield point(ctx.log, "ball", name, "dt", dt, None, 0, "",
+                            {"error": math.nan}, status=f"failed: {note}")
                 continue
             ball = mj.MujocoBall(ctx.mujoco, p, dt, dampratio)
             restitution = ball.effective_restitution()
@@ -379,12 +375,11 @@ def ball_mujoco(ctx: Context) -> list[dict[str, Any]]:
             wall, repeats, final = ctx.timed(partial(ball.run, float(gaps[0]), num_steps))
             y, v = ball.trajectories(gaps, num_steps)
             difference = max(abs(y[0, -1] - final[0]), abs(v[0, -1] - final[1]))
-            points.append(point(
+            yield point(
                 ctx.log, "ball", name, "dt", dt, wall, repeats, "mujoco_one_call",
                 ball_errors(p, gaps, y, v, dt), replay_difference=float(difference),
-                dampratio=dampratio, effective_restitution=restitution))
+                dampratio=dampratio, effective_restitution=restitution)
     ctx.calibrations = calibrations
-    return points
 
 
 def stick_slip_closed_form(theta: float, mu: float, mass: float, rate: float, gravity: float
@@ -501,9 +496,8 @@ def _state_errors(samples: np.ndarray, reference: np.ndarray) -> dict[str, float
     return {"error": float(difference.max()), "final_error": float(difference[-1].max())}
 
 
-def manipulator_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
+def manipulator_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
     """Moreau-Jean points: one ``step_batch`` call per phase (timed), replayed per sample."""
-    points = []
     for dt in ctx.config.manipulator_time_steps:
         phases = manipulator_phases(dt)
         run = ctx.copies(models.BlockableManipulator, None, dt)
@@ -517,33 +511,28 @@ def manipulator_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
             for _ in range(steps // stride):
                 run.advance(stride)
                 samples.append(run.state())
-        points.append(point(
+        yield point(
             ctx.log, "manipulator", "mj_enumerative", "dt", dt, wall, repeats, "mj_per_phase",
             _state_errors(np.array(samples), ctx.reference),
-            replay_difference=float(np.abs(samples[-1] - final).max())))
-    return points
+            replay_difference=float(np.abs(samples[-1] - final).max()))
 
 
-def manipulator_event_driven(ctx: Context) -> list[dict[str, Any]]:
+def manipulator_event_driven(ctx: Context) -> Iterator[dict[str, Any]]:
     """Event-driven points at each rtol (sampling at the 4 ms grid included in the time)."""
     torque, brake, _ = manipulator_schedule()
     grid = SAMPLE_INTERVAL * np.arange(ctx.reference.shape[0])
-    points = []
     for rtol in ctx.config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
         wall, repeats, trajectory = ctx.timed(partial(
             stepping.simulate_manipulator, None, [0.0, 0.0], [0.0, 0.0], torque, brake,
             MANIPULATOR_HORIZON, sample_times=grid, **options))
         errors = _state_errors(np.hstack([trajectory.q, trajectory.u]), ctx.reference)
-        points.append(point(ctx.log, "manipulator", "event_driven", "rtol", rtol, wall, repeats,
-                            "ed", errors, atol=options["atol"],
-                            rhs_evaluations=trajectory.num_rhs_evals))
-    return points
+        yield point(ctx.log, "manipulator", "event_driven", "rtol", rtol, wall, repeats, "ed",
+                    errors, atol=options["atol"], rhs_evaluations=trajectory.num_rhs_evals)
 
 
-def manipulator_mujoco(ctx: Context) -> list[dict[str, Any]]:
+def manipulator_mujoco(ctx: Context) -> Iterator[dict[str, Any]]:
     """MuJoCo arm points per brake solref setting and dt."""
-    points = []
     for series in ctx.config.mujoco_arm_series:
         for dt in ctx.config.mujoco_arm_time_steps:
             solref = None if series == "default" else (2.0 * dt, 1.0)
@@ -553,11 +542,10 @@ def manipulator_mujoco(ctx: Context) -> list[dict[str, Any]]:
             wall, repeats, (final, _) = ctx.timed(partial(arm.simulate, phases))
             _, samples = arm.simulate(phases, _steps(SAMPLE_INTERVAL, dt))
             assert samples is not None
-            points.append(point(
+            yield point(
                 ctx.log, "manipulator", f"mujoco_{series}", "dt", dt, wall, repeats,
                 "mujoco_per_phase", _state_errors(samples, ctx.reference),
-                replay_difference=float(np.abs(samples[-1] - final).max()), **arm.brake_settings))
-    return points
+                replay_difference=float(np.abs(samples[-1] - final).max()), **arm.brake_settings)
 
 
 def diff_drive_run(ctx: Context, dt: float) -> tuple[Callable[[], np.ndarray], Copies]:
@@ -567,7 +555,7 @@ def diff_drive_run(ctx: Context, dt: float) -> tuple[Callable[[], np.ndarray], C
                              for duration, tau in DIFF_DRIVE_PHASES]), run
 
 
-def diff_drive_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
+def diff_drive_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
     """Robot points against the fine-step reference (its record into ``ctx.references``)."""
     dt_ref = ctx.config.diff_drive_reference_step
     reference_run, reference_copies = diff_drive_run(ctx, dt_ref)
@@ -579,15 +567,13 @@ def diff_drive_moreau_jean(ctx: Context) -> list[dict[str, Any]]:
               "final_state": [float(x) for x in reference]}
     ctx.log(f"diff-drive reference dt = {dt_ref:g}: |x(2 dt_ref) - x(dt_ref)| = "
             f"{record['self_difference']:.1e}")
-    points = []
     for dt in ctx.config.diff_drive_time_steps:
         call, copies = diff_drive_run(ctx, dt)
         wall, repeats, final = ctx.timed(call)
-        points.append(point(ctx.log, "diff_drive", "mj_newton_ac", "dt", dt, wall, repeats,
-                            "mj_per_phase", {"error": float(np.abs(final - reference).max())},
-                            worst_solver_status=SolverStatus(copies.worst_status).name))
+        yield point(ctx.log, "diff_drive", "mj_newton_ac", "dt", dt, wall, repeats,
+                    "mj_per_phase", {"error": float(np.abs(final - reference).max())},
+                    worst_solver_status=SolverStatus(copies.worst_status).name)
     ctx.references["diff_drive"] = record
-    return points
 
 
 def observed_order(points: Sequence[dict[str, Any]]) -> float | None:
@@ -651,11 +637,11 @@ def evaluate_targets(points: Sequence[dict[str, Any]]
     return targets, comparison
 
 
-def _section(ctx: Context, name: str, study: Callable[[Context], list[dict[str, Any]]]
+def _section(ctx: Context, name: str, study: Callable[[Context], Iterable[dict[str, Any]]]
              ) -> list[dict[str, Any]]:
     """Run one study; on an exception note it (``main`` then exits with 1) and go on."""
     try:
-        return study(ctx)
+        return list(study(ctx))
     except Exception as error:  # noqa: BLE001 - one failed study must not lose the others
         message = f"{name} failed: {type(error).__name__}: {error}"
         ctx.notes.append(message)
