@@ -164,13 +164,9 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
         calls[f"mujoco|{scene}|mj_step"] = call
     log(f"single step: {len(calls)} callables, interleaved ...")
     timed = timing.time_interleaved(calls, config.single_plan)
-    rows = []
-    for key, value in timed.items():
-        model, scene, entry = key.split("|")
-        steps = IN_PLACE_STEPS_PER_CALL if entry == "in_place" else 1
-        rows.append({"model": model, "scene": scene, "entry": entry,
-                     **value.summary(operations_per_call=steps)})
-    return rows
+    return [{**dict(zip(("model", "scene", "entry"), key.split("|"), strict=True)),
+             **value.summary(IN_PLACE_STEPS_PER_CALL if key.endswith("|in_place") else 1)}
+            for key, value in timed.items()]
 
 
 def _batched_entry(st: MoreauJeanStepper, initial: tuple, target_s: float,

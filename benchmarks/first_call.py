@@ -17,8 +17,7 @@ def main() -> None:
     from benchmarks import problems as entries
 
     problem = entries.random_problem("spd", 5, 0)
-    probes = [entries.KERNEL] + [entries.driver_entry(m) for m in entries.LCP_METHODS]
-    probes.append(entries.QUANTECON)
+    probes = [entries.KERNEL, *map(entries.driver_entry, entries.LCP_METHODS), entries.QUANTECON]
     first_call = {e.name: seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
     second_call = {e.name: seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
     report = {"import_s": import_times, "first_call_s": first_call, "second_call_s": second_call}
