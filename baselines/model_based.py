@@ -78,20 +78,24 @@ def mpc_controller(env_id: str, objective: str) -> Controller | None:
 def tracking_controller(env_id: str, objective: str) -> Controller | None:
     """The tracking MPC along the reference of (env id, objective), supervised on the robot.
 
-    None without a reference or CasADi.
+    On time-optimal tasks it turns state-indexed (``INDEX_WINDOW``) once it finds less friction
+    than its model (``TrackingMPC.index_on_less_friction``); on the effort tasks, whose episode
+    ends with the reference's horizon, it stays time-indexed. None without a reference or CasADi.
     """
     from optimal.tracking import TrackingMPC
 
-    return reference_controller(TRACKING, TrackingMPC, env_id, objective, supervised=True)
+    return reference_controller(TRACKING, TrackingMPC, env_id, objective, supervised=True,
+                                index_window=INDEX_WINDOW if objective == "time" else 0,
+                                index_on_less_friction=True)
 
 
 class Recovering:
     """A reference tracker on the robot, then, past the reference's end, the parking follower.
 
-    For the first N steps (N the reference's intervals) the policy is ``tracker`` (a
-    ``StateFeedbackPolicy``); at step N, unless the episode has ended in the goal box, it
-    switches to ``parking_follower`` from the observed pose, with the nominal model's parameters
-    (the model the tracker has: a mismatch in the env stays unknown to both).
+    The policy is ``tracker`` (a ``StateFeedbackPolicy``) until it has acted for the reference's
+    last interval (its ``last_step`` N - 1: after N steps if time-indexed); then, unless the
+    episode has ended in the goal box, it switches to ``parking_follower`` from the observed
+    pose, with the nominal model's parameters (the follower does not adapt to a mismatch).
 
     Args:
         tracker: the policy along the reference (reset by ``reset``).
@@ -101,7 +105,7 @@ class Recovering:
 
     def __init__(self, tracker: Any, reference: Reference, env: gym.Env[Any, Any]) -> None:
         self.tracker = tracker
-        self.steps = len(reference.tau)
+        self.last_node = len(reference.tau) - 1
         self._parameters = model_of(make_problem(reference.name))[1]
         self._dt = float(env.unwrapped.dt)
         self._torque = float(env.unwrapped.scene.max_wheel_torque)
@@ -115,7 +119,7 @@ class Recovering:
 
     def __call__(self, observation: Any) -> Any:
         """The env action at this step."""
-        if self.recovery is None and self._step >= self.steps:
+        if self.recovery is None and self._step and self.tracker.last_step >= self.last_node:
             self.recovery = parking_follower(self._parameters, self._dt, self._torque,
                                              observation)
         self._step += 1
@@ -135,14 +139,14 @@ def tracking_state_controller(env_id: str, objective: str) -> Controller | None:
 
 def reference_controller(label: str, controller_class: Callable[[Reference], Any], env_id: str,
                          objective: str, needs_casadi: bool = True, supervised: bool = False,
-                         index_window: int = 0) -> Controller | None:
+                         **attributes: Any) -> Controller | None:
     """The row ``label``: ``controller_class(reference)`` along the reference of the task.
 
     None without a reference for (env id, objective), or without CasADi when ``needs_casadi``.
     The controller is built at the row's first episode (a row not played costs nothing) and
     serves every episode, reset at each (its built NLPs or gains stay). ``supervised``: on the
-    robot (a model without brakes) it is wrapped in ``Recovering``. ``index_window``: its
-    ``StateFeedbackPolicy.index_window`` (0: time-indexed).
+    robot (a model without brakes) it is wrapped in ``Recovering``. ``attributes`` are set on
+    the controller, e.g. its ``StateFeedbackPolicy.index_window`` (default 0: time-indexed).
     """
     name = REFERENCE_NAMES.get((env_id, objective))
     if name is None or (needs_casadi and importlib.util.find_spec("casadi") is None):
@@ -153,7 +157,8 @@ def reference_controller(label: str, controller_class: Callable[[Reference], Any
     def make_policy(env: Any) -> Any:
         if not built:
             built.append(controller_class(reference))
-            built[0].index_window = index_window
+            for name, value in attributes.items():
+                setattr(built[0], name, value)
         policy = built[0]
         if supervised and not policy.has_brake:
             policy = Recovering(policy, reference, env)

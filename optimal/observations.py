@@ -61,12 +61,12 @@ class StateFeedbackPolicy:
     ``control`` at it, encodes the torques and brake bounds as the Box action and records its
     CPU time [s].
 
-    The step is the number of calls this episode (time-indexed) when ``index_window`` is 0;
-    otherwise (state-indexed) it is ``nearest_node`` of the measured state, searched from the
-    last call's step (0 at the first call) over the ``index_window`` nodes after it, so it never
-    goes back. A time-indexed policy that lags the reference acts for a later phase of it; a
-    state-indexed one acts for the phase it is in, so its action is a function of the state
-    and of the last step only.
+    The step is the number of calls this episode (time-indexed) unless ``is_state_indexed``
+    (``index_window`` > 0 by default); then it is ``nearest_node`` of the measured state,
+    searched from the last call's step (0 at the first call) over the ``index_window`` nodes
+    after it, so it never goes back. A time-indexed policy that lags the reference acts for a
+    later phase of it; a state-indexed one acts for the phase it is in, so its action is a
+    function of the state and of the last step only. ``last_step`` is the last call's step.
     """
 
     has_brake: bool
@@ -75,7 +75,7 @@ class StateFeedbackPolicy:
     node_states: FloatArray
     node_weight: FloatArray
     index_window: int = 0
-    _index: int = 0
+    last_step: int = 0
 
     def predicted_q(self, step: int) -> FloatArray:
         """(n,) the q expected at env step ``step`` (angles unwrapped near it)."""
@@ -84,6 +84,10 @@ class StateFeedbackPolicy:
     def control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""
         raise NotImplementedError
+
+    def is_state_indexed(self) -> bool:
+        """Whether this call's step is the state's ``nearest_node`` (else the call count)."""
+        return bool(self.index_window)
 
     def nearest_node(self, q: FloatArray, u: FloatArray, first: int) -> int:
         """The node k in ``first`` ... ``first + index_window`` nearest (q, u).
@@ -98,11 +102,13 @@ class StateFeedbackPolicy:
         """The env action for an observation of the reference's env."""
         clock = time.process_time()
         step = len(self.compute_times)
-        if self.index_window:
-            step = self._index if step else 0
+        state_indexed = self.is_state_indexed()
+        if state_indexed:
+            step = self.last_step if step else 0
         q, u = decode_observation(observation, self.predicted_q(step), self.has_brake)
-        if self.index_window:
-            step = self._index = self.nearest_node(q, u, step)
+        if state_indexed:
+            step = self.nearest_node(q, u, step)
+        self.last_step = step
         tau, brake = self.control(step, q, u)
         action = [tau / self.torque_bound]
         if self.has_brake:

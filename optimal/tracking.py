@@ -29,6 +29,15 @@ instead breaks the dynamics there, from where IPOPT converges to local minima of
 off the reference). IPOPT runs from a small barrier
 parameter to a loose tolerance (``SOLVER_OPTIONS``) and at most ``MAX_ITERATIONS`` iterations;
 if it fails, the LQR's control is applied (``fallbacks``) and its last iterate is dropped.
+
+On a model with friction contacts (the robot) the window NLPs take a friction factor as a
+parameter (``Transcription(parametric_friction=True)``): every control step first feeds the
+last measured step to a ``optimal.traction.FrictionEstimator`` and solves with its estimate, so
+a floor with more or less grip than the model is planned for once a contact has slipped on it.
+With ``index_on_less_friction`` the controller is time-indexed until the estimate falls below
+the model's friction and state-indexed (``index_window``) from then on: with less grip the
+reference's timing is out of reach, and a time-indexed window would chase a reference that
+runs away from the robot, while a state-indexed one follows its path at the robot's pace.
 """
 
 from __future__ import annotations
@@ -43,14 +52,18 @@ from optimal.continuation import POLISH_RELAXATION
 from optimal.lqr import TimeVaryingLQR
 from optimal.modes import ModePattern
 from optimal.observations import StateFeedbackPolicy
-from optimal.problems import make_problem
+from optimal.problems import make_problem, model_of
 from optimal.references import Reference
+from optimal.traction import FrictionEstimator
 from optimal.transcription import GUESS_IMPULSES, Transcription
 
-HORIZON = {"manipulator_time": 30}
+HORIZON = {"manipulator_time": 30, "diff_drive_effort": 40}
 """Intervals of the window (one env step each) per reference, ``DEFAULT_HORIZON`` for the others.
 The manipulator's underactuated swing needs the longer window: at 15 intervals its plans
-saturate behind the reference and arrive 1.5x late from 0.1-perturbed starts."""
+saturate behind the reference and arrive 1.5x late from 0.1-perturbed starts. The robot's
+effort reference ends in a skid whose length grows as the friction falls: on a floor with 20 %
+less grip the window must reach from before the skid to the fixed horizon (1.6 s) to slow the
+robot in time; at 15 or 30 intervals it ends the skid 0.07-0.2 m past the goal."""
 
 DEFAULT_HORIZON = 15
 """The window of references not in ``HORIZON``."""
@@ -86,6 +99,11 @@ class TrackingMPC(StateFeedbackPolicy):
         compute_times: CPU time [s] of each control step of this episode.
         fallbacks: steps of this episode at which IPOPT failed and the LQR's control was applied.
         iterations: IPOPT's iterations per step of this episode.
+        traction: the ``FrictionEstimator`` (None: a model without friction contacts).
+        friction_factors: its estimate at each step of this episode.
+        index_on_less_friction: state-indexed only from the step at which the friction
+            estimate is first below 1 this episode (see the module docstring); False (default):
+            state-indexed whenever ``index_window`` is set.
     """
 
     def __init__(self, reference: Reference, horizon: int | None = None,
@@ -97,6 +115,13 @@ class TrackingMPC(StateFeedbackPolicy):
         self.node_states, self.node_weight = self.lqr.node_states, self.lqr.node_weight
         self.base = make_problem(reference.name, len(reference.tau))
         self.has_brake = bool(self.base.model.NUM_BRAKES)
+        model, parameters = model_of(self.base)
+        n = model.NUM_DOFS
+        self.traction = None
+        if model.HAS_LOAD_TRANSFER and model.NUM_CONTACTS:  # the robot: its chassis velocity
+            weight = np.zeros(n)
+            weight[:2] = self.node_weight[n:n + 2]
+            self.traction = FrictionEstimator(model, parameters, reference.time_step, weight)
         self.torque_bound = float(reference.metadata["torque_bound"])
         steps, n = len(reference.tau), self.base.model.NUM_DOFS
         extension = self.horizon if self.has_brake else 0
@@ -121,20 +146,52 @@ class TrackingMPC(StateFeedbackPolicy):
         self.compute_times: list[float] = []
         self.fallbacks: list[int] = []
         self.iterations: list[int] = []
+        self.friction_factors: list[float] = []
         self._previous: tuple[_Window, FloatArray, FloatArray, int] | None = None
+        self._measured: tuple[FloatArray, FloatArray, FloatArray] | None = None
+        self.index_on_less_friction = False
+        self._less_friction = False
 
     def reset(self) -> None:
-        """A new episode: step counter, records and warm start start again."""
+        """A new episode: step counter, records, warm start and friction estimate start again."""
         self.compute_times, self.fallbacks, self.iterations = [], [], []
-        self._previous = None
+        self.friction_factors = []
+        self._previous = self._measured = None
+        self._less_friction = False
+        if self.traction is not None:
+            self.traction.reset()
 
     def predicted_q(self, step: int) -> FloatArray:
         """(n,) the reference's q at env step ``step`` (the goal past the end)."""
         x = self._x[min(step, len(self._keys) - 1)]
         return x[:x.size // 2]
 
+    def is_state_indexed(self) -> bool:
+        """With ``index_window``: always, or once the friction estimate fell below 1.
+
+        The latter with ``index_on_less_friction``, from then on for the rest of the episode.
+        """
+        if self.traction is not None and self.traction.factor < 1.0:
+            self._less_friction = True
+        return bool(self.index_window) and (self._less_friction or not self.index_on_less_friction)
+
     def control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""
+        """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u).
+
+        Each call is taken as the env step after the last call's (its torques applied).
+        """
+        tau, brake = self._control(step, q, u)
+        self._measured = (q, u, tau)
+        return tau, brake
+
+    def _control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """``control`` without recording the step."""
+        extra = []
+        if self.traction is not None:
+            if self._measured is not None:
+                self.traction.update(*self._measured, u)
+            self.friction_factors.append(self.traction.factor)
+            extra = [self.traction.factor]
         if step >= len(self._keys):  # past the reference: the hold window, or the LQR
             if not self.has_brake:
                 return self.lqr.control(step, q, u)
@@ -152,7 +209,7 @@ class TrackingMPC(StateFeedbackPolicy):
         length = window.shapes[0][1] - 1  # intervals: q has one column per node
         end = k + length
         x, lam, tau = window.solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
-                                   self._terminal[end], x0, lam0)
+                                   self._terminal[end], *extra, x0, lam0)
         stats = window.solve.stats()
         self.iterations.append(int(stats.get("iter_count", -1)))
         brake = self._brake[k] if self._brake is not None else np.zeros(0)
@@ -181,7 +238,8 @@ class TrackingMPC(StateFeedbackPolicy):
         big_h, h = modes.num_intervals, self.reference.time_step
         problem = dataclasses.replace(self.base, num_intervals=big_h, cost="effort",
                                       final_time=big_h * h, goal_q={}, goal_u={})
-        t = Transcription(problem, modes=modes, parametric_start=True)
+        t = Transcription(problem, modes=modes, parametric_start=True,
+                          parametric_friction=self.traction is not None)
         opti = t.opti
         n2, m = 2 * self.base.model.NUM_DOFS, self.base.model.NUM_INPUTS
         x_ref, tau_ref = opti.parameter(n2, big_h + 1), opti.parameter(m, big_h)
@@ -199,8 +257,9 @@ class TrackingMPC(StateFeedbackPolicy):
         q0, u0 = t._start
         opti.set_value(t.rho, 0.0)
         opti.set_value(t.relaxation, POLISH_RELAXATION)
-        solve = opti.to_function("window", [q0, u0, x_ref, tau_ref, terminal, opti.x, opti.lam_g],
-                                 [opti.x, opti.lam_g, t.tau])
+        friction = [t.friction_factor] if self.traction is not None else []
+        solve = opti.to_function("window", [q0, u0, x_ref, tau_ref, terminal, *friction,
+                                            opti.x, opti.lam_g], [opti.x, opti.lam_g, t.tau])
         return _Window(t, solve, [raw.shape for raw, _ in t._raw.values()])
 
     def _reference_point(self, k: int) -> FloatArray:

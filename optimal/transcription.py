@@ -177,10 +177,14 @@ class Transcription:
         parametric_start: the initial state is an NLP parameter (``set_start``), so that one
             built NLP serves every start (the MPC's re-solves); False states the problem's
             ``initial_q``/``initial_u`` as constants.
+        parametric_friction: every friction coefficient of load-transfer contacts is the
+            model's times ``friction_factor``, an NLP parameter (1 until set), so that one
+            built NLP serves a friction estimated on line (the tracking MPC's).
         opti: the ``casadi.Opti`` instance.
         q: (n, N+1) coordinates. u: (n, N+1) velocities. tau: (m, N) inputs.
         final_time: t_f (a variable or a float). step: h = t_f / N.
         rho: penalty weight (parameter). relaxation: bound r on each scaled product (parameter).
+        friction_factor: the ``parametric_friction`` parameter (1.0 without it).
         pairs: the complementarity pairs. cost: the problem's cost (expression).
         outputs: named expressions extracted from a solution (impulses, slips, ...).
         solver_settings: what ``optimal.continuation.set_solver`` last set (None: nothing).
@@ -189,6 +193,7 @@ class Transcription:
     problem: OptimalControlProblem
     modes: ModePattern | None = None
     parametric_start: bool = False
+    parametric_friction: bool = False
     opti: Any = field(init=False)
     q: Any = field(init=False)
     u: Any = field(init=False)
@@ -197,6 +202,7 @@ class Transcription:
     step: Any = field(init=False)
     rho: Any = field(init=False)
     relaxation: Any = field(init=False)
+    friction_factor: Any = field(init=False, default=1.0)
     cost: Any = field(init=False)
     pairs: list[Pair] = field(init=False, default_factory=list)
     outputs: dict[str, Any] = field(init=False, default_factory=dict)
@@ -236,6 +242,9 @@ class Transcription:
         h = self.final_time / big_n
         self.step = h
         self.rho, self.relaxation = opti.parameter(), opti.parameter()
+        if self.parametric_friction:
+            self.friction_factor = opti.parameter()
+            opti.set_value(self.friction_factor, 1.0)
 
         modes = self.modes or ModePattern()
         if modes.num_intervals not in (0, big_n):
@@ -248,7 +257,7 @@ class Transcription:
             if d != 3:
                 raise NotImplementedError("load-transfer contacts are transcribed in 3-D only")
             contact = _LoadTransferLaw(opti, self.variable, model, values, big_n, s_imp, s_vel,
-                                       modes.sliding)
+                                       modes.sliding, self.friction_factor)
         elif c:
             if any(mu > 0.0 for mu in model.friction_coefficients(values)) or d != 2:
                 raise NotImplementedError("gap contacts are transcribed without friction only")
@@ -586,6 +595,7 @@ class _LoadTransferLaw:
     impulse_unit: float
     velocity_unit: float
     sliding: Any = None
+    friction_factor: Any = 1.0
 
     def __post_init__(self) -> None:
         c = self.model.NUM_CONTACTS
@@ -613,6 +623,7 @@ class _LoadTransferLaw:
         tangent_rows = casadi.vertcat(*[rows[3 * j + 1:3 * j + 3, :] for j in range(c)])
         p_t = self.tangent[:, i]
         p_n = self._n0 * h + self._gain @ p_t
+        mu = [self.friction_factor * self._mu[j] for j in range(c)]
         slip = tangent_rows @ u_next
         unit, speed_unit = self.impulse_unit, self.velocity_unit
         self.opti.subject_to(p_n / unit >= 0)
@@ -620,7 +631,7 @@ class _LoadTransferLaw:
         stated: list[int] = []  # rows of W_T already set to zero in this interval
         for j in range(c):
             pj, sj = p_t[2 * j:2 * j + 2], slip[2 * j:2 * j + 2]
-            cones.append((self._mu[j] * p_n[j]) ** 2 - casadi.sumsqr(pj))
+            cones.append((mu[j] * p_n[j]) ** 2 - casadi.sumsqr(pj))
             if at_rest:
                 self.opti.subject_to(self.slip_speed[j, i] / speed_unit == 0)
             elif self.sliding is not None and not self.sliding[j, i]:  # sticks
@@ -631,7 +642,7 @@ class _LoadTransferLaw:
                         stated.append(row)
             else:
                 self.opti.subject_to(
-                    (self._mu[j] * p_n[j] * sj + self.slip_speed[j, i] * pj)
+                    (mu[j] * p_n[j] * sj + self.slip_speed[j, i] * pj)
                     / (unit * speed_unit) == 0
                 )
                 if self.sliding is not None:  # slides: on the cone

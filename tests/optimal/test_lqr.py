@@ -91,7 +91,7 @@ def test_a_state_indexed_lqr_finds_the_reference_node_of_the_state() -> None:
 
     def policy(observation: np.ndarray) -> np.ndarray:
         action = controller(observation)
-        indices.append(controller._index)
+        indices.append(controller.last_step)
         return action
 
     info = _play(policy, reference, 0, 0.0)

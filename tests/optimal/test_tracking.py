@@ -100,3 +100,31 @@ def test_steps_without_a_plan_keep_no_memory() -> None:
     growth_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - start
     assert controller.fallbacks == list(range(60))
     assert growth_kb < 10 * 1024  # the unbounded growth kept ~100 MB per such step
+
+
+def test_on_a_floor_with_less_grip_the_robots_tracker_adapts_and_follows_the_path() -> None:
+    """One step of the reference's start (both wheels slip) on a floor with 20 % less friction.
+
+    Before it the tracker plans with the model's friction and is time-indexed; after it, with
+    the floor's, and (``index_on_less_friction``) state-indexed.
+    """
+    from mdi_envs.stepping import MoreauJeanStepper
+    from optimal.problems import make_problem, model_of
+    from optimal.traction import scaled_friction
+
+    reference = load_reference("diff_drive_time")
+    controller = TrackingMPC(reference, horizon=3)
+    controller.index_window, controller.index_on_less_friction = 10, True
+    controller.reset()
+    model, parameters = model_of(make_problem(reference.name))
+    floor = MoreauJeanStepper(model, scaled_friction(parameters, 0.8), reference.time_step)
+    q, u = reference.q[0], reference.u[0]
+    assert not controller.is_state_indexed()
+    tau, _ = controller.control(0, q, u)
+    step = floor.step(q, u, tau)
+    controller.control(1, step.q, step.u)
+    assert controller.friction_factors[0] == 1.0
+    assert controller.friction_factors[1] == pytest.approx(0.8, abs=1e-4)
+    assert controller.is_state_indexed()
+    controller.reset()
+    assert controller.traction.factor == 1.0 and not controller.is_state_indexed()

@@ -90,3 +90,28 @@ def test_robot_polish_nlp_has_the_same_variables(num_intervals: int) -> None:
     assert polished.opti.nx == transcription.opti.nx
     assert polished.modes is not None
     assert polished.modes.sliding.shape == (3, num_intervals)
+
+
+def test_a_parametric_friction_factor_is_the_models_friction_scaled() -> None:
+    """At any point, the constraints with factor 0.8 are those of the model with 0.8 mu."""
+    import dataclasses
+
+    from optimal.problems import model_of
+    from optimal.traction import scaled_friction
+
+    problem = make_problem("diff_drive_time", 3)
+    parametric = Transcription(problem, parametric_friction=True)
+    slippery = Transcription(dataclasses.replace(
+        problem, parameters=scaled_friction(model_of(problem)[1], 0.8)))
+    point = np.random.default_rng(0).normal(size=parametric.opti.nx)
+    values = []
+    for transcription, factor in ((parametric, 0.8), (slippery, None), (parametric, 1.0)):
+        opti = transcription.opti
+        for parameter in (transcription.rho, transcription.relaxation):
+            opti.set_value(parameter, 0.0)
+        if factor is not None:
+            opti.set_value(transcription.friction_factor, factor)
+        constraints = casadi.Function("g", [opti.x, opti.p], [opti.g])
+        values.append(numeric(constraints(point, opti.value(opti.p))))
+    np.testing.assert_allclose(values[0], values[1], rtol=1e-12, atol=1e-12)
+    assert np.abs(values[2] - values[1]).max() > 1e-3
