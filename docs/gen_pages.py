@@ -271,7 +271,9 @@ def comparison_page() -> None:
     studies = headline.comparisons(folder)
     lines = ["# RL vs MPC vs optimal", "",
              "Generated from `baselines/comparison/compare_*.json` (written by "
-             "`mdi-envs compare all --output baselines/comparison`). Each controller plays 20 "
+             "`mdi-envs compare ENV --scales 0.01 0.1 --output baselines/comparison`; the v1 "
+             "studies' DAgger rows with `--trained baselines/distilled --controllers DAgger`). "
+             "Each controller plays 20 "
              "perturbed starts per run; success is the fraction reaching the goal, ratios are "
              "time (or effort) over the optimal reference's, over the successes; IQM and 95 % "
              "stratified-bootstrap CI over runs (rliable). The method: "

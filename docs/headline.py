@@ -22,8 +22,9 @@ PLOT = ROOT / "docs" / "assets" / "headline.png"
 
 
 def comparisons(folder: Path = COMPARISON_DIR) -> list[Study]:
-    """Every committed ``compare_*.json`` (``baselines.records.read_study``), sorted by name."""
-    return [read_study(p) for p in sorted(folder.glob("compare_*.json"))]
+    """Every committed ``compare_*.json`` (``baselines.records.read_study``): v0 ids first."""
+    studies = [read_study(p) for p in sorted(folder.glob("compare_*.json"))]
+    return sorted(studies, key=lambda study: study.env_id.rsplit("-", 1)[-1])
 
 
 def _scores(study: Study, row: Row) -> tuple[Estimate, Estimate]:
@@ -56,23 +57,25 @@ def headline_frame(studies: list[Study]) -> pd.DataFrame:
 
 
 def headline_plot(studies: list[Study], path: Path = PLOT) -> Path:
-    """Success (bars) and ratio to the optimum (dots) per controller, one panel per study."""
+    """Success (bars) and ratio to the optimum (dots) per controller; a panel per study, 3 a row."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(studies), figsize=(4.2 * len(studies), 3.4), squeeze=False)
-    for ax, study in zip(axes[0], studies, strict=True):
-        labels = [row.label.replace(" (shrinking horizon)", "").replace(" (open loop)",
-                                                                        "\n(open loop)")
-                  for row in study.rows]
+    columns = min(3, len(studies))
+    rows = -(-len(studies) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows), squeeze=False)
+    for ax in axes.flat[len(studies):]:
+        ax.set_visible(False)
+    for ax, study in zip(axes.flat, studies, strict=False):
+        labels = [_short(row.label) for row in study.rows]
         success, ratio = zip(*(_scores(study, row) for row in study.rows), strict=True)
         x = range(len(labels))
         ax.bar(x, [s.iqm or 0.0 for s in success], color="tab:green", alpha=0.8,
                yerr=_errors(success), capsize=3, label="success (IQM, 95 % CI)")
         ax.set_ylim(0, 1.05)
-        ax.set_xticks(list(x), labels, fontsize=7)
+        ax.set_xticks(list(x), labels, fontsize=7, rotation=35, ha="right")
         ax.set_title(f"{study.env_id.removeprefix('mdi_envs/')}, {study.objective}", fontsize=9)
         twin = ax.twinx()
         shown = [i for i, r in enumerate(ratio) if r.iqm is not None]
@@ -80,11 +83,11 @@ def headline_plot(studies: list[Study], path: Path = PLOT) -> Path:
                       yerr=_errors([ratio[i] for i in shown]), fmt="o", color="black",
                       capsize=3, label="time or effort / optimal")
         twin.axhline(1.0, color="gray", lw=0.8, ls=":")
-        twin.set_ylim(0, 2.2)
+        twin.set_ylim(0, max([2.2] + [1.1 * ratio[i].iqm for i in shown]))
         if ax is axes[0][0]:
             ax.set_ylabel("success rate")
             ax.legend(loc="lower left", fontsize=7)
-        if ax is axes[0][-1]:
+        if ax is axes[0][columns - 1]:
             twin.set_ylabel("time or effort / optimal")
             twin.legend(loc="lower right", fontsize=7)
     fig.tight_layout()
@@ -92,6 +95,19 @@ def headline_plot(studies: list[Study], path: Path = PLOT) -> Path:
     fig.savefig(path, dpi=90)
     plt.close(fig)
     return path
+
+
+SHORT_LABELS = {
+    "optimal (open loop)": "optimal, open loop", "LQR (time-varying)": "LQR",
+    "MPC (shrinking horizon)": "MPC, shrinking", "MPC (tracking window)": "MPC, tracking",
+    "MPC (tracking window), state-indexed": "MPC, tracking by state",
+    "rigid-arm bang-bang": "bang-bang floor", "rolling path follower": "rolling floor",
+}
+"""Row labels as the plot's tick labels."""
+
+
+def _short(label: str) -> str:
+    return SHORT_LABELS.get(label, label)
 
 
 def _errors(estimates: Sequence[Estimate]) -> list[list[float]]:
