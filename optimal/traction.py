@@ -21,6 +21,7 @@ from collections import deque
 from typing import Any
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from mdi_envs._types import FloatArray
 from mdi_envs.stepping import MoreauJeanStepper
@@ -78,8 +79,6 @@ class FrictionEstimator:
 
     def update(self, q: FloatArray, u: FloatArray, tau: FloatArray, u_next: FloatArray) -> float:
         """The estimate after a measured step: (q, u) under ``tau`` to velocities ``u_next``."""
-        from scipy.optimize import minimize_scalar
-
         self._steps.append((q, u, tau, u_next))
         self._errors.append(np.array([self._error(stepper, *self._steps[-1])
                                       for stepper in self._steppers]))
