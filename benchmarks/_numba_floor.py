@@ -1,4 +1,4 @@
-"""One trivial cached numba kernel: the floor of a process start with numba (``startup_probe``)."""
+"""One trivial cached numba kernel: the floor of a process start with numba (``probes.startup``)."""
 
 import numpy as np
 from numba import njit

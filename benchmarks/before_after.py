@@ -1,7 +1,7 @@
 """Speed before and after a change, in one run: the engine and env benchmarks on two trees.
 
 ``python -m benchmarks.before_after --before DIR [--rounds 2]`` runs the quick engine and env
-benchmarks and ``in_place_probe`` alternately on the package in DIR and on this tree, in fresh
+benchmarks and ``probes.in_place`` alternately on the package in DIR and on this tree, in fresh
 interpreters, and writes the medians and ratios to ``before_after.json`` and ``.png``.
 """
 
@@ -59,7 +59,7 @@ def run_once(tree: Path, scratch: Path, log: Progress) -> dict[str, tuple[float,
                       for t in [*(record.get("targets") or []), probe]
                       if isinstance(t.get("measured"), (int, float))})
     for model in ("manipulator", "diff_drive"):  # (min, median) µs of the in-place probe
-        fastest, median = _run_in(tree, scratch, "in_place_probe", model).split()
+        fastest, median = _run_in(tree, scratch, "probes", "in-place", model).split()
         for statistic, value in (("min", fastest), ("median", median)):
             found[f"in-place probe: {model} InPlaceStepper.step(), {statistic} over 300 "
                   "batches"] = (float(value), "µs")
@@ -80,15 +80,13 @@ def run(before: Path, rounds: int, output: Path) -> str:
                     units[target] = unit
     rows = []
     for target, runs in samples.items():
-        if not (runs["before"] and runs["after"]):
-            continue
-        old, new = (statistics.median(runs[label]) for label in ("before", "after"))
-        unit = units[target]
-        rate = "/s" in unit or "×" in unit or "per s" in unit  # higher is better
-        slowdown = old / new if rate else new / old
-        rows.append({"target": target, "unit": unit, "before": old, "after": new,
-                     "slowdown": slowdown, "ok": slowdown <= LIMIT, "before_runs": runs["before"],
-                     "after_runs": runs["after"]})
+        if runs["before"] and runs["after"]:
+            old, new = (statistics.median(runs[label]) for label in ("before", "after"))
+            rate = any(mark in units[target] for mark in ("/s", "×", "per s"))  # higher: better
+            slowdown = old / new if rate else new / old
+            rows.append({"target": target, "unit": units[target], "before": old, "after": new,
+                         "slowdown": slowdown, "ok": slowdown <= LIMIT,
+                         "before_runs": runs["before"], "after_runs": runs["after"]})
     record = {"machine": machine_info(), "before_tree": str(before), "rounds": rounds,
               "limit": LIMIT, "rows": rows}
     output.mkdir(parents=True, exist_ok=True)

@@ -66,18 +66,16 @@ def run_bench(args: argparse.Namespace) -> int:
     output = args.output or (DEFAULT_OUTPUT / "quick" if args.quick else DEFAULT_OUTPUT)
     output.mkdir(parents=True, exist_ok=True)
     failures: list[str] = []
+    argv = ["--output", str(output)] + (["--quick"] if args.quick else [])
     for name in names:
-        module_name = BENCHMARKS[name][0]
-        start = time.perf_counter()
+        module_name, start = BENCHMARKS[name][0], time.perf_counter()
         print(f"== bench {name} ({module_name}){' --quick' if args.quick else ''}", flush=True)
-        argv = ["--output", str(output)] + (["--quick"] if args.quick else [])
         try:
             code = importlib.import_module(module_name).main(argv)
         except Exception:  # a crash of one benchmark is reported, the others still run
             traceback.print_exc()
             code = 1
-        if code:
-            failures.append(name)
+        failures += [name] if code else []
         print(f"== bench {name}: {'FAILED' if code else 'ok'} in "
               f"{time.perf_counter() - start:.0f} s", flush=True)  # fmt: skip
     print(write_headline(output))

@@ -30,7 +30,7 @@ from benchmarks.engine_scenes import (
     stepper,
 )
 from benchmarks.report import bars, format_us, log_lines, plt, save_figure, summary
-from benchmarks.timing import Progress, TimingPlan
+from benchmarks.timing import Log, TimingPlan
 from mdi_envs.mechanics.compiled import compile_equations
 from mdi_envs.stepping import MoreauJeanStepper, StepShortcuts
 
@@ -104,7 +104,7 @@ QUICK = EngineConfig(
 TARGETS_US = {"manipulator_batched": 0.1, "manipulator_python": 1.0, "diff_drive": 2.0}
 
 
-def compile_stepper(case: ModelCase, log: Progress, records: list[dict[str, Any]],
+def compile_stepper(case: ModelCase, log: Log, records: list[dict[str, Any]],
                     shortcuts: StepShortcuts | None = None) -> MoreauJeanStepper:
     """Build a stepper; append the times of its first ``step`` and ``step_batch`` to ``records``.
 
@@ -150,7 +150,7 @@ def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
 
 
 def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
-                      arm: MujocoArm | None, config: EngineConfig, log: Progress
+                      arm: MujocoArm | None, config: EngineConfig, log: Log
                       ) -> list[dict[str, Any]]:
     """Per scene: ``step`` and ``InPlaceStepper.step`` from Python, and MuJoCo's ``mj_step``."""
     calls: dict[str, Callable[[], Any]] = {}
@@ -206,7 +206,7 @@ def _entry(call: BatchedCall) -> tuple[BatchedCall, int]:
 
 
 def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
-                arm: MujocoArm | None, config: EngineConfig, log: Progress
+                arm: MujocoArm | None, config: EngineConfig, log: Log
                 ) -> list[dict[str, Any]]:
     """In-kernel µs per step of each scene: ``step_batch`` with every copy in that scene."""
     n = config.scene_copies
@@ -220,7 +220,7 @@ def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
 
 
 def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
-                  arm: MujocoArm | None, config: EngineConfig, log: Progress
+                  arm: MujocoArm | None, config: EngineConfig, log: Log
                   ) -> list[dict[str, Any]]:
     """µs per copy-step of each model's mix (and MuJoCo's) for every N, interleaved per N."""
     rows = []
@@ -238,7 +238,7 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
 
 
 def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
-                   config: EngineConfig, log: Progress) -> list[dict[str, Any]]:
+                   arm: MujocoArm | None, config: EngineConfig, log: Log) -> list[dict[str, Any]]:
     """µs per copy-step of each model's mix at N = ``scene_copies`` for a few substeps per call."""
     if not config.substep_grid:
         return []
@@ -250,8 +250,8 @@ def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
 
 
 def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
-                   config: EngineConfig, log: Progress, compile_records: list[dict]
-                   ) -> list[dict[str, Any]]:
+                   arm: MujocoArm | None, config: EngineConfig, log: Log,
+                   compile_records: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Each shortcut on vs off on the same scene, batched, interleaved pair by pair."""
     by_label = {c.label: c for c in cases}
     variants: dict[tuple[str, StepShortcuts], MoreauJeanStepper] = {}
@@ -295,22 +295,18 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
     return rows
 
 
-def brake_stop_study(steppers: dict[str, MoreauJeanStepper], arm: MujocoArm | None,
-                     log: Progress) -> dict[str, Any]:
+def brake_stop_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
+                     arm: MujocoArm | None, config: EngineConfig, log: Log) -> dict[str, Any]:
     """Steps to stop a 1 rad/s relative motion after the brake engages: ours and MuJoCo's."""
     result: dict[str, Any] = {}
     st = steppers.get("manipulator")
     if st is not None:
-        q, u = np.zeros(2), np.array([0.0, 1.0])
-        trace = [1.0]
-        steps = None
-        for k in range(1, 101):
+        q, u, trace, steps = np.zeros(2), np.array([0.0, 1.0]), [1.0], None
+        while steps is None and len(trace) <= 100:  # at most 100 steps
             out = st.step(q, u, np.zeros(1), np.array([np.inf]))
             q, u = out.q, out.u
             trace.append(abs(float(u[1] - u[0])))
-            if trace[-1] < 0.01:
-                steps = k
-                break
+            steps = len(trace) - 1 if trace[-1] < 0.01 else None
         result["ours"] = {"steps": steps, "relative_speed_after_first_step": trace[1],
                           "relative_angle_at_stop": float(q[1] - q[0]),
                           "relative_speed_trace": trace}
@@ -344,53 +340,40 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
 
 def run(config: EngineConfig, output: Path, quick: bool) -> str:
     """Run the whole benchmark, write the outputs and return the Markdown report."""
-    log = Progress()
-    output.mkdir(parents=True, exist_ok=True)
-    record: dict[str, Any] = {
-        "machine": timing.machine_info((*timing.VERSIONED_PACKAGES, "mujoco")),
-        "config": {"quick": quick, "time_step": TIME_STEP,
-                   **{k: v for k, v in asdict(config).items() if k != "shortcut_cases"}},
-        "notes": [], "load_log": []}
-    section = partial(timing.checkpoint, record, progress=log)
-    log(f"engine benchmark ({'quick' if quick else 'full'}) -> {output}; load {timing.load_text()}")
-    cases = model_cases(config.models)
-    mujoco, mujoco_note = import_mujoco()
-    arm = MujocoArm(mujoco) if mujoco is not None else None
-    if mujoco_note:
-        record["notes"].append(mujoco_note)
-        log(mujoco_note)
-    section("compile")
-    compile_records: list[dict[str, Any]] = []
-    steppers = {case.label: compile_stepper(case, log, compile_records) for case in cases}
-    record["models"] = [case_record(c) for c in cases]
-    if arm is not None and "manipulator" in steppers:
-        st, ours = steppers["manipulator"], np.empty((2, 2))
-        compile_equations(st.model).mass(np.array(MANIPULATOR_Q), st._values, ours)
-        record["mujoco_mass_matrix_difference"] = arm.mass_matrix_check(ours)
-    section("single step")
-    single = single_step_study(cases, steppers, arm, config, log)
-    section("per scene")
-    scenes = scene_study(cases, steppers, arm, config, log)
-    section("batched")
-    batched = batched_study(cases, steppers, arm, config, log)
-    section("substeps")
-    substeps = substeps_study(cases, steppers, config, log)
-    section("shortcuts")
-    shortcuts = shortcut_study(cases, steppers, config, log, compile_records)
-    section("brake stop")
-    brake = brake_stop_study(steppers, arm, log)
-    if arm is not None:
-        arm.close()
-    section("end")
-    record.update({"compile": compile_records, "single_step": single, "per_scene": scenes,
-                   "batched": batched, "substeps": substeps, "shortcuts": shortcuts,
-                   "brake_stop": brake, "targets": evaluate_targets(single, batched)})
-    plot_batched(batched, substeps, TARGETS_US, output / "engine_batched.png")
-    plot_single_step(single, scenes, TARGETS_US, output / "engine_single_step.png")
-    plot_shortcuts(shortcuts, output / "engine_shortcuts.png")
-    timing.finish(record, log.elapsed, speed=True)
-    report.write_json(record, output / "engine.json")
-    log(f"done in {log.elapsed:.0f} s; wrote engine.json and 3 plots to {output}")
+    settings = {"quick": quick, "time_step": TIME_STEP,
+                **{k: v for k, v in asdict(config).items() if k != "shortcut_cases"}}
+    packages = (*timing.VERSIONED_PACKAGES, "mujoco")
+    with report.study("engine", output, settings, packages, speed=True) as (record, log, clock):
+        record["notes"] = []
+        cases = model_cases(config.models)
+        mujoco, mujoco_note = import_mujoco()
+        arm = MujocoArm(mujoco) if mujoco is not None else None
+        if mujoco_note:
+            record["notes"].append(mujoco_note)
+            log(mujoco_note)
+        timing.checkpoint(record, "compile", clock)
+        record["compile"] = []
+        steppers = {case.label: compile_stepper(case, log, record["compile"]) for case in cases}
+        record["models"] = [case_record(c) for c in cases]
+        if arm is not None and "manipulator" in steppers:
+            st, ours = steppers["manipulator"], np.empty((2, 2))
+            compile_equations(st.model).mass(np.array(MANIPULATOR_Q), st._values, ours)
+            record["mujoco_mass_matrix_difference"] = arm.mass_matrix_check(ours)
+        studies = {"single_step": single_step_study, "per_scene": scene_study,
+                   "batched": batched_study, "substeps": substeps_study,
+                   "shortcuts": partial(shortcut_study, compile_records=record["compile"]),
+                   "brake_stop": brake_stop_study}
+        for key, study in studies.items():
+            timing.checkpoint(record, key.replace("_", " "), clock)
+            record[key] = study(cases, steppers, arm, config, log)
+        if arm is not None:
+            arm.close()
+        timing.checkpoint(record, "end", clock)
+        record["targets"] = evaluate_targets(record["single_step"], record["batched"])
+        plot_batched(record["batched"], record["substeps"], output / "engine_batched.png")
+        plot_single_step(record["single_step"], record["per_scene"],
+                         output / "engine_single_step.png")
+        plot_shortcuts(record["shortcuts"], output / "engine_shortcuts.png")
     return markdown_report(record)
 
 
@@ -432,7 +415,7 @@ def markdown_report(record: Mapping[str, Any]) -> str:
 
 
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],
-                 targets_us: Mapping[str, float], path: Path) -> None:
+                 path: Path, targets_us: Mapping[str, float] = TARGETS_US) -> None:
     """µs per copy-step against N (and against substeps per call), one line per model."""
     panels = 2 if substeps else 1
     fig, axes = plt.subplots(1, panels, figsize=(7.5 + 4.5 * (panels - 1), 4.8), sharey=True,
@@ -455,7 +438,7 @@ def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str,
 
 
 def plot_single_step(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str, Any]],
-                     targets_us: Mapping[str, float], path: Path) -> None:
+                     path: Path, targets_us: Mapping[str, float] = TARGETS_US) -> None:
     """Horizontal bars per (model, scene): Python step, in-place step, in-kernel step [µs]."""
     index = {(r["model"], r["scene"], r["entry"]): r["median_s"] * 1e6 for r in single}
     index.update({(r["model"], r["scene"], "kernel"): r["per_copy_step_s"] * 1e6 for r in scenes})

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -105,11 +106,7 @@ class MujocoArm:
 
     def single_step_calls(self) -> dict[str, Any]:
         """Scene -> zero-argument ``mj_step(model, data)`` (the state advances call by call)."""
-        calls = {}
-        for scene in SCENES:
-            model, data = self._data(scene)
-            calls[scene] = (lambda m=model, d=data: self.mujoco.mj_step(m, d))
-        return calls
+        return {scene: partial(self.mujoco.mj_step, *self._data(scene)) for scene in SCENES}
 
     def rollout_call(self, num_copies: int, num_steps: int,
                      scenes: tuple[str, ...] = SCENES) -> Any:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -22,7 +22,7 @@ import numba
 import mdi_envs
 from benchmarks import report, timing
 from benchmarks.report import bars, log_lines, plt, save_figure, summary
-from benchmarks.timing import Progress, TimingPlan
+from benchmarks.timing import Log, TimingPlan
 
 ACROBOT, MUJOCO_PEER = "Acrobot-v1", "InvertedDoublePendulum-v5"
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
@@ -65,23 +65,18 @@ QUICK = EnvsConfig(
 
 def frame_skip(env: Any) -> int:
     """Physics steps per env step: ``scene.frame_skip`` for ours, ``frame_skip`` (MuJoCo) else 1."""
-    if hasattr(env, "envs"):
-        env = env.envs[0]
-    inner = env.unwrapped
-    scene = getattr(inner, "scene", None)
-    if scene is not None and hasattr(scene, "frame_skip"):
-        return int(scene.frame_skip)
-    return int(getattr(inner, "frame_skip", 1))
+    inner = (env.envs[0] if hasattr(env, "envs") else env).unwrapped
+    return int(getattr(getattr(inner, "scene", None), "frame_skip",
+                       getattr(inner, "frame_skip", 1)))
 
 
 def _wrapper_chain(env: Any) -> list[str]:
     """Class names from the outermost wrapper down to the env."""
-    names = []
-    while True:
-        names.append(type(env).__name__)
-        if not isinstance(env, gym.Wrapper):
-            return names
+    names = [type(env).__name__]
+    while isinstance(env, gym.Wrapper):
         env = env.env
+        names.append(type(env).__name__)
+    return names
 
 
 def _sample_actions(space: gym.Space, count: int, seed: int) -> list[Any]:
@@ -91,6 +86,7 @@ def _sample_actions(space: gym.Space, count: int, seed: int) -> list[Any]:
 
 
 STEPS_PER_CALL = 64  # ``env.step`` calls per timed call of a ``StepLoop``.
+STATISTICS = ("median", "q1", "q3", "min")  # of the times over rounds, as in ``Timed.summary``
 
 
 class StepLoop:
@@ -155,8 +151,7 @@ def _make_single(env_id: str, ours: bool, seed: int, samples: int
     bare.reset(seed=seed)
     bare.step(actions[0])
     bare.reset(seed=seed)
-    spec = env.spec
-    max_steps = spec.max_episode_steps if spec is not None else None
+    max_steps = env.spec.max_episode_steps if env.spec is not None else None
     record = {"env_id": env_id, "ours": ours, "wrappers": _wrapper_chain(env),
               "frame_skip": frame_skip(env),
               "dt_s": float(env.unwrapped.dt) if hasattr(env.unwrapped, "dt") else None,
@@ -166,8 +161,7 @@ def _make_single(env_id: str, ours: bool, seed: int, samples: int
 
 
 def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsConfig,
-                     log: Callable[[str], None]
-                     ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+                     log: Log) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """``env.step`` through ``gym.make`` and unwrapped, for ours and the peers, interleaved."""
     records, unavailable = [], []
     loops: dict[str, StepLoop] = {}
@@ -189,8 +183,7 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
             loop = loops[f"{record['env_id']}|{entry}"]
             summary = timed[f"{record['env_id']}|{entry}"].summary(loop.steps_per_call)
             record[entry] = {
-                **{f"{stat}_us": summary[f"{stat}_s"] * 1e6 for stat in ("median", "q1", "q3",
-                                                                         "min")},
+                **{f"{stat}_us": summary[f"{stat}_s"] * 1e6 for stat in STATISTICS},
                 "rounds": summary["rounds"], "number": summary["number"],
                 "steps_per_call": loop.steps_per_call, "steps_total": loop.steps,
                 "episodes_ended": loop.episodes}
@@ -203,18 +196,12 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
 def _add_ratios(records: list[dict[str, Any]]) -> None:
     """Peer time / our time for each of ours and each peer (medians and fastest rounds)."""
     peers = [r for r in records if not r["ours"]]
-    for record in records:
-        if not record["ours"]:
-            continue
-        record["ratios"] = {
-            peer["env_id"]: {
-                "ratio_median": peer["gym.make"]["median_us"] / record["gym.make"]["median_us"],
-                "ratio_fastest": peer["gym.make"]["min_us"] / record["gym.make"]["min_us"],
-                "ratio_median_unwrapped": (peer["unwrapped"]["median_us"]
-                                           / record["unwrapped"]["median_us"]),
-            }
-            for peer in peers
-        }
+    for ours in (r for r in records if r["ours"]):
+        ours["ratios"] = {peer["env_id"]: {
+            "ratio_median": peer["gym.make"]["median_us"] / ours["gym.make"]["median_us"],
+            "ratio_fastest": peer["gym.make"]["min_us"] / ours["gym.make"]["min_us"],
+            "ratio_median_unwrapped": (peer["unwrapped"]["median_us"]
+                                       / ours["unwrapped"]["median_us"])} for peer in peers}
 
 
 def _vector_entry(env_id: str, mode: str, num_envs: int, config: EnvsConfig
@@ -233,7 +220,7 @@ def _vector_entry(env_id: str, mode: str, num_envs: int, config: EnvsConfig
                   "action_batches": samples}
 
 
-def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Callable[[str], None]
+def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Log
                  ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Env-steps/s and physics steps/s of each vector env per N, interleaved per N."""
     rows: list[dict[str, Any]] = []
@@ -327,44 +314,32 @@ def _pin(cpu: int | None) -> tuple[set[int] | None, dict[str, Any]]:
     return previous, {"pinned": True, "cpus": sorted(os.sched_getaffinity(0))}
 
 
-def run(config: EnvsConfig, output: Path, quick: bool, log: Callable[[str], None] | None = None
-        ) -> str:
+def run(config: EnvsConfig, output: Path, quick: bool, log: Log | None = None) -> str:
     """Run the whole benchmark, write the outputs and return the Markdown report."""
-    progress = Progress()
-    log = log or progress
-    output.mkdir(parents=True, exist_ok=True)
+    env_ids = tuple(config.env_ids if config.env_ids is not None else mdi_envs.ENV_IDS)
+    settings = {"quick": quick, "env_ids": env_ids,
+                **{k: v for k, v in asdict(config).items() if k != "env_ids"}}
     previous, pinning = _pin(config.cpu)
     try:
-        env_ids = tuple(config.env_ids if config.env_ids is not None else mdi_envs.ENV_IDS)
-        record: dict[str, Any] = {
-            "machine": timing.machine_info(VERSIONED),
-            "pinning": pinning,
-            "numba_threading": {"num_threads": numba.config.NUMBA_NUM_THREADS,
-                                "threading_layer": numba.config.THREADING_LAYER,
-                                "parallel_kernels_used": False},
-            "config": {"quick": quick, "env_ids": env_ids,
-                       **{k: v for k, v in asdict(config).items() if k != "env_ids"}},
-            "units": UNITS, "targets_brief": TARGETS, "notes": [], "load_log": []}
-        log(f"env benchmark ({'quick' if quick else 'full'}) -> {output}; pinned to "
-            f"{pinning['cpus']}; load {timing.load_text()}")
-        timing.checkpoint(record, "single env", progress)
-        single, unavailable = single_env_study(env_ids, config.peers, config, log)
-        timing.checkpoint(record, "vector env", progress)
-        vector, vector_unavailable = vector_study(env_ids, config, log)
-        timing.checkpoint(record, "end", progress)
-        for item in (*unavailable, *vector_unavailable):
-            record["notes"].append(f"{item['env_id']}"
-                                   f"{' (' + item['mode'] + ')' if 'mode' in item else ''} "
-                                   f"not measured: {item['error']}")
-        record.update({"single_env": single, "unavailable": unavailable, "vector_env": vector,
-                       "vector_unavailable": vector_unavailable,
-                       "targets": evaluate_targets(single, vector)})
-        plot_step(single, unavailable, TARGETS, output / "envs_step.png")
-        plot_vector(vector, TARGETS, output / "envs_vector.png")
-        timing.finish(record, progress.elapsed, speed=True)
-        report.write_json(record, output / "envs.json")
-        log(f"done in {progress.elapsed:.0f} s; wrote envs.json, envs_step.png and "
-            f"envs_vector.png to {output}")
+        with report.study("envs", output, settings, VERSIONED, True, log) as (record, log, clock):
+            record.update({"pinning": pinning, "numba_threading": {
+                "num_threads": numba.config.NUMBA_NUM_THREADS,
+                "threading_layer": numba.config.THREADING_LAYER, "parallel_kernels_used": False},
+                "units": UNITS, "targets_brief": TARGETS, "notes": []})
+            log(f"pinned to {pinning['cpus']}; load {timing.load_text()}")
+            timing.checkpoint(record, "single env", clock)
+            single, unavailable = single_env_study(env_ids, config.peers, config, log)
+            timing.checkpoint(record, "vector env", clock)
+            vector, vector_unavailable = vector_study(env_ids, config, log)
+            timing.checkpoint(record, "end", clock)
+            for item in (*unavailable, *vector_unavailable):
+                mode = f" ({item['mode']})" if "mode" in item else ""
+                record["notes"].append(f"{item['env_id']}{mode} not measured: {item['error']}")
+            record.update({"single_env": single, "unavailable": unavailable,
+                           "vector_env": vector, "vector_unavailable": vector_unavailable,
+                           "targets": evaluate_targets(single, vector)})
+            plot_step(single, unavailable, TARGETS, output / "envs_step.png")
+            plot_vector(vector, TARGETS, output / "envs_vector.png")
     finally:
         if previous is not None:
             os.sched_setaffinity(0, previous)

@@ -16,7 +16,7 @@ import numpy as np
 from benchmarks import report
 from benchmarks.problems import peer_data_dir
 from benchmarks.report import plt
-from benchmarks.timing import Progress, arguments, load_average, machine_info
+from benchmarks.timing import arguments
 from mdi_envs.solvers import SolverStatus, fc3d_residual, solve_fc3d
 from mdi_envs.solvers.siconos_io import read_friction_contact
 
@@ -46,41 +46,36 @@ def time_solve(data: Any, method: str, options: dict[str, Any]) -> tuple[Any, fl
 
 def run(output: Path, quick: bool) -> str:
     """Run every method on every peer problem, write the JSON and the plot, return the table."""
-    log = Progress()
-    output.mkdir(parents=True, exist_ok=True)
-    folder = peer_data_dir() / "fc3d"
-    files = sorted(folder.glob("*.dat")) if folder.is_dir() else []
-    if not files:
-        log(f"peer data {folder} absent: nothing to run")
-    for method in METHODS:  # compile (or load) every method's kernels outside the timings
-        solve_fc3d(np.eye(6) + 0.1, np.array([-1.0, 0.5, 0.0, -1.0, 0.0, 2.0]),
-                   np.array([0.3, 0.3]), method=method)
-    rows = []
-    for path in files:
-        data = read_friction_contact(path)
-        n = int(data.q.shape[0])
-        if quick and n > QUICK_MAX_N:
-            continue
-        row: dict[str, Any] = {"name": path.stem, "n": n, "contacts": n // 3}
-        for method, options in METHODS.items():
-            result, seconds = time_solve(data, method, options)
-            residual = float(fc3d_residual(data.W, data.q, data.mu, result.r))
-            row[method] = {"time_s": seconds, "residual": residual, "status": result.status.name,
-                           "iterations": int(result.num_iter),
-                           "converged": result.status is SolverStatus.CONVERGED}
-        row["solved"] = any(row[m]["converged"] for m in METHODS)
-        rows.append(row)
-        log(f"{path.stem} (n={n}): " + ", ".join(f"{m} {row[m]['status']}" for m in METHODS))
-    solved = {m: sum(r[m]["converged"] for r in rows) for m in METHODS}
-    record = {"machine": {**machine_info(), "load_average_at_end": load_average()},
-              "config": {"quick": quick, "tol": TOL, "methods": METHODS}, "problems": rows,
-              "solved_by_method": solved, "solved_by_any": sum(r["solved"] for r in rows),
-              "run_time_s": log.elapsed}
-    report.write_json(record, output / "fc3d.json")
-    if rows:  # without peer data nothing is drawn (a log axis of no values fails)
-        plot(rows, output / "fc3d.png")
-    log(f"done in {log.elapsed:.0f} s; wrote fc3d.json"
-        f"{' and fc3d.png' if rows else ' (no problems)'} to {output}")
+    settings = {"quick": quick, "tol": TOL, "methods": METHODS}
+    with report.study("fc3d", output, settings) as (record, log, _):
+        folder = peer_data_dir() / "fc3d"
+        files = sorted(folder.glob("*.dat")) if folder.is_dir() else []
+        if not files:
+            log(f"peer data {folder} absent: nothing to run")
+        for method in METHODS:  # compile (or load) every method's kernels outside the timings
+            solve_fc3d(np.eye(6) + 0.1, np.array([-1.0, 0.5, 0.0, -1.0, 0.0, 2.0]),
+                       np.array([0.3, 0.3]), method=method)
+        rows = []
+        for path in files:
+            data = read_friction_contact(path)
+            n = int(data.q.shape[0])
+            if quick and n > QUICK_MAX_N:
+                continue
+            row: dict[str, Any] = {"name": path.stem, "n": n, "contacts": n // 3}
+            for method, options in METHODS.items():
+                result, seconds = time_solve(data, method, options)
+                row[method] = {"time_s": seconds, "status": result.status.name,
+                               "residual": float(fc3d_residual(data.W, data.q, data.mu, result.r)),
+                               "iterations": int(result.num_iter),
+                               "converged": result.status is SolverStatus.CONVERGED}
+            row["solved"] = any(row[m]["converged"] for m in METHODS)
+            rows.append(row)
+            log(f"{path.stem} (n={n}): " + ", ".join(f"{m} {row[m]['status']}" for m in METHODS))
+        record.update({"problems": rows, "solved_by_any": sum(r["solved"] for r in rows),
+                       "solved_by_method": {m: sum(r[m]["converged"] for r in rows)
+                                            for m in METHODS}})
+        if rows:  # without peer data nothing is drawn (a log axis of no values fails)
+            plot(rows, output / "fc3d.png")
     return markdown(record)
 
 

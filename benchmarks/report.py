@@ -6,9 +6,10 @@ the headline table holds every benchmark's target checks and the stress verdicts
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after selecting the non-interactive backend)
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
+
+from benchmarks.timing import VERSIONED_PACKAGES, Log, Progress, finish, machine_info  # noqa: E402
 
 
 def format_us(seconds: float | None) -> str:
@@ -136,7 +139,7 @@ def target_value(value: float | None, unit: str) -> str:
 
 
 def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
-    """Markdown: target, threshold, measured, met (✓, ✗, ``–`` undecided, not measured), note."""
+    """Markdown: (benchmark,) target, threshold, measured, met (✓, ✗, ``–`` undecided), note."""
     def threshold(t: Mapping[str, Any]) -> str:
         if t["threshold"] is None:
             return "(comparison)"
@@ -144,6 +147,7 @@ def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
         return f"{t['comparison']} {t['threshold']:g}{unit}"
 
     return markdown_table([{
+        **({"benchmark": t["benchmark"]} if t.get("benchmark") else {}),
         "target": t["target"], "threshold": threshold(t),
         "measured": target_value(t["measured"], t["unit"]),
         "met": {True: "✓", False: "✗"}.get(t["met"], "–" if t["measured"] is not None
@@ -183,6 +187,25 @@ def write_json(record: dict[str, Any], path: Path) -> None:
     """Write the full record (indented; numpy scalars as Python numbers)."""
     path.write_text(json.dumps(record, indent=1, default=lambda v: v.item()) + "\n")
 
+
+@contextlib.contextmanager
+def study(name: str, output: Path, config: dict[str, Any],
+          packages: Sequence[str] = VERSIONED_PACKAGES, speed: bool = False,
+          log: Log | None = None) -> Iterator[tuple[dict[str, Any], Log, Progress]]:
+    """A run's (record, log, clock); at the end: load, ``speed`` probe, time, ``output/NAME.json``.
+
+    The record opens with ``machine`` (``packages``' versions) and ``config`` (with ``quick``).
+    """
+    progress = Progress()
+    say = log or progress
+    output.mkdir(parents=True, exist_ok=True)
+    record: dict[str, Any] = {"machine": machine_info(tuple(packages)), "config": config}
+    say(f"{name} benchmark ({'quick' if config['quick'] else 'full'}) -> {output}")
+    yield record, say, progress
+    finish(record, progress.elapsed, speed)
+    write_json(json_safe(record), output / f"{name}.json")
+    say(f"done in {progress.elapsed:.0f} s; wrote {name}.json and its plots to {output}")
+
 HEADLINE_SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
                     ("precision", "work_precision.json"), ("stress", "stress.json"),
                     ("startup", "startup.json"), ("control", "control.json"))  # fmt: skip
@@ -220,14 +243,8 @@ def engine_peer_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
-def _number(value: Any) -> str:
-    if isinstance(value, float):
-        return f"{value:.3g}"
-    return "-" if value is None else str(value)
-
-
 def write_headline(folder: Path) -> str:
-    """Write ``headline.json`` and ``headline.md`` from the results in ``folder``."""
+    """Write ``headline.json`` and ``headline.md`` (``targets_table`` per row) from ``folder``."""
     folder = Path(folder)
     rows: list[dict[str, Any]] = []
     runs = {}
@@ -242,12 +259,6 @@ def write_headline(folder: Path) -> str:
                  for target in (record.get("targets") or []) + (extra(record) if extra else [])]
     (folder / "headline.json").write_text(json.dumps({"runs": runs, "rows": rows}, indent=1,
                                                      default=str) + "\n")  # fmt: skip
-    text = markdown_table(
-        [[r["benchmark"], r["target"], f"{_number(r['measured'])} {r['unit']}".strip(),
-          "(comparison)" if r["threshold"] is None
-          else f"{r['comparison']} {_number(r['threshold'])} {r['unit']}".strip(),
-          "yes" if r["met"] else "**no**", r["note"]] for r in rows],
-        ["benchmark", "target", "measured", "target value", "met", "note"],
-    ) if rows else f"no benchmark results with targets in {folder}"  # fmt: skip
+    text = targets_table(rows) if rows else f"no benchmark results with targets in {folder}"
     (folder / "headline.md").write_text(text + "\n")
     return text

@@ -18,7 +18,7 @@ import pandas as pd
 from benchmarks import problems as E
 from benchmarks import report, timing
 from benchmarks.report import bars, log_lines, plt, save_figure, summary
-from benchmarks.timing import Progress, TimingPlan
+from benchmarks.timing import Log, TimingPlan
 
 ENTRY_KEYS = ("driver", "kernel", "quantecon")  # the entries of the QuantEcon comparison
 RESIDUAL_FLOOR = 1e-18  # zero residuals are drawn here on log axes
@@ -50,7 +50,7 @@ QUICK = BenchConfig(
     peer_plan=TimingPlan(budget_s=0.02, min_rounds=3, max_rounds=30), cold_compile=False)
 
 
-def measure_first_calls(config: BenchConfig, log: Progress) -> dict[str, Any]:
+def measure_first_calls(config: BenchConfig, log: Log) -> dict[str, Any]:
     """First-call (compile or cache-load) times, each from a fresh interpreter."""
     results = {}
     for label, cold in (("warm_cache", False), ("cold_cache", True))[:1 + config.cold_compile]:
@@ -72,16 +72,12 @@ def time_problem(problem: E.Problem, chosen: Sequence[E.Entry], plan: TimingPlan
     """Time entries on one problem in interleaved rounds and read their outcomes."""
     calls = {e.name: (lambda e=e: e.solve(problem.M, problem.q)) for e in chosen}
     timed = timing.time_interleaved(calls, plan)
-    return {
-        e.name: {
-            "time": timed[e.name].summary(),
-            "outcome": asdict(e.read(timed[e.name].result, problem.M, problem.q)),
-        }
-        for e in chosen
-    }
+    return {e.name: {"time": timed[e.name].summary(),
+                     "outcome": asdict(e.read(timed[e.name].result, problem.M, problem.q))}
+            for e in chosen}
 
 
-def size_study(config: BenchConfig, log: Progress) -> list[dict[str, Any]]:
+def size_study(config: BenchConfig, log: Log) -> list[dict[str, Any]]:
     """Every method on every (family, n, instance) of the grid; one record per entry."""
     records = []
     for family in E.FAMILIES:
@@ -103,7 +99,7 @@ def size_study_entries(n: int) -> list[E.Entry]:
             if m != "enumerative" or n <= E.ENUMERATIVE_MAX_N] + [E.QUANTECON]
 
 
-def comparison_problems(config: BenchConfig, log: Progress) -> list[E.Problem]:
+def comparison_problems(config: BenchConfig, log: Log) -> list[E.Problem]:
     """The Siconos peer LCP files (if present) and the random problems n = 10, 20, ..., 100."""
     peers = E.peer_lcp_problems()
     log(f"peer data: {len(peers)} LCP files from {E.peer_data_dir() / 'lcp'}" if peers else
@@ -122,18 +118,17 @@ FIXED_COST_PROBLEMS = (
 """n = 2 problems on which a call's time is almost all fixed cost (dispatch, checks, result)."""
 
 
-def compare_lemke(problems: Sequence[E.Problem], plan: TimingPlan, log: Progress
+def compare_lemke(problems: Sequence[E.Problem], plan: TimingPlan, log: Log
                   ) -> list[dict[str, Any]]:  # fmt: skip
     """Our Lemke (driver and compiled entry) against QuantEcon's, interleaved, per problem."""
-    keys = {"driver": E.DRIVER_LEMKE, "kernel": E.KERNEL, "quantecon": E.QUANTECON}
+    keys = dict(zip(ENTRY_KEYS, (E.DRIVER_LEMKE, E.KERNEL, E.QUANTECON), strict=True))
     rows = []
     for problem in problems:
         measured = time_problem(problem, list(keys.values()), plan)
-        row: dict[str, Any] = {"name": problem.name, "family": problem.family, "n": problem.n}
-        row.update({key: measured[entry.name] for key, entry in keys.items()})
-        qe_time = row["quantecon"]["time"]["median_s"]
-        row["ratio_driver"] = row["driver"]["time"]["median_s"] / qe_time
-        row["ratio_kernel"] = row["kernel"]["time"]["median_s"] / qe_time
+        row = {"name": problem.name, "family": problem.family, "n": problem.n,
+               **{key: measured[entry.name] for key, entry in keys.items()}}
+        row.update({f"ratio_{key}": row[key]["time"]["median_s"]
+                    / row["quantecon"]["time"]["median_s"] for key in ("driver", "kernel")})
         rows.append(row)
         log(f"{problem.name} (n={problem.n}): " + ", ".join(
             f"{key} {report.format_us(row[key]['time']['median_s'])} µs" for key in keys)
@@ -143,29 +138,21 @@ def compare_lemke(problems: Sequence[E.Problem], plan: TimingPlan, log: Progress
 
 def run(config: BenchConfig, output: Path, quick: bool) -> str:
     """Run the whole benchmark, write the outputs and return the Markdown report."""
-    log = Progress()
-    output.mkdir(parents=True, exist_ok=True)
-    record: dict[str, Any] = {
-        "machine": timing.machine_info(),
-        "config": {"quick": quick, **asdict(config)},
-    }
-    log(f"LCP solver benchmark ({'quick' if quick else 'full'}) -> {output}")
-    record["first_call"] = measure_first_calls(config, log)
-    warm_up([E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)])
-    record["fixed_cost"] = [{k: v for k, v in row.items() if not k.startswith(("family", "ratio"))}
-                            for row in compare_lemke(FIXED_COST_PROBLEMS, config.peer_plan, log)]
-    records = size_study(config, log)
-    aggregates = aggregate_size_study(records)
-    record["size_study"] = {"records": records, "aggregates": aggregates}
-    rows = compare_lemke(comparison_problems(config, log), config.peer_plan, log)
-    record["quantecon_comparison"] = {"quantecon_max_iter": E.QUANTECON_MAX_ITER,
-                                      "problems": rows, "median_ratios": ratio_summary(rows)}
-    plot_by_entry(aggregates, output / "solvers_time_vs_size.png", "time_median_s")
-    plot_by_entry(aggregates, output / "solvers_residual_vs_size.png", "residual_max")
-    plot_ratios(rows, output / "lemke_vs_quantecon.png")
-    timing.finish(record, log.elapsed)
-    report.write_json(record, output / "solvers.json")
-    log(f"done in {log.elapsed:.0f} s; wrote solvers.json and 3 plots to {output}")
+    with report.study("solvers", output, {"quick": quick, **asdict(config)}) as (record, log, _):
+        record["first_call"] = measure_first_calls(config, log)
+        warm_up([E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)])
+        record["fixed_cost"] = [
+            {k: v for k, v in row.items() if not k.startswith(("family", "ratio"))}
+            for row in compare_lemke(FIXED_COST_PROBLEMS, config.peer_plan, log)]
+        records = size_study(config, log)
+        aggregates = aggregate_size_study(records)
+        record["size_study"] = {"records": records, "aggregates": aggregates}
+        rows = compare_lemke(comparison_problems(config, log), config.peer_plan, log)
+        record["quantecon_comparison"] = {"quantecon_max_iter": E.QUANTECON_MAX_ITER,
+                                          "problems": rows, "median_ratios": ratio_summary(rows)}
+        plot_by_entry(aggregates, output / "solvers_time_vs_size.png", "time_median_s")
+        plot_by_entry(aggregates, output / "solvers_residual_vs_size.png", "residual_max")
+        plot_ratios(rows, output / "lemke_vs_quantecon.png")
     return markdown_report(record)
 
 

@@ -1,6 +1,6 @@
 """Start-up time: a fresh interpreter to its first env step returned (``mdi-envs bench startup``).
 
-Each case runs ``startup_probe`` in a new process through ``gym.make``, ``gym.make_vec`` or an SB3
+Each case runs ``probes.startup`` in a new process through ``gym.make``, ``gym.make_vec`` or an SB3
 ``SubprocVecEnv``, warm (cache filled by ``mdi-envs compile all``) and, in the full run, cold;
 beside Acrobot-v1 and InvertedDoublePendulum-v5. Writes ``startup.json`` and ``startup.png``.
 ``--python-path DIR`` runs the probes on the package in DIR.
@@ -19,12 +19,12 @@ from pathlib import Path
 from typing import Any
 
 from benchmarks import report
-from benchmarks.startup_probe import FLOOR
+from benchmarks.probes import FLOOR
 from benchmarks.timing import Progress, arguments, fresh_python, machine_info
 
 REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
 """Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
-row, ``startup_probe.FLOOR``) the floor of any numba env: one trivial cached kernel's load."""
+row, ``probes.FLOOR``) the floor of any numba env: one trivial cached kernel's load."""
 ENTRIES = ("single", "vector", "subproc")
 QUICK_IDS = ("mdi_envs/BlockableManipulator-v1", "Acrobot-v1")
 """The ids ``--quick`` probes (warm, once, gym.make and gym.make_vec), besides the floor."""
@@ -41,7 +41,7 @@ def time_to_first_step(entry: str, env_id: str, cache: Path | None,
                        python_path: Path | None = None) -> dict[str, Any]:
     """Seconds from starting a fresh interpreter to its first ``step`` returned, and phases."""
     started = time.time()
-    process = fresh_python("-m", "benchmarks.startup_probe", entry, env_id,
+    process = fresh_python("-m", "benchmarks.probes", "startup", entry, env_id,
                            **_paths(cache, python_path))
     lines = [line for line in process.stdout.splitlines() if line.startswith("{")]
     if process.returncode != 0 or not lines:
@@ -62,12 +62,8 @@ def compile_all(cache: Path | None, python_path: Path | None = None) -> dict[str
 def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     seconds = [run["seconds"] for run in runs if "seconds" in run]
     errors = [run["error"] for run in runs if "error" in run]
-    summary: dict[str, Any] = {"runs": runs}
-    if seconds:
-        summary.update(median=statistics.median(seconds), min=min(seconds))
-    if errors:
-        summary["errors"] = errors
-    return summary
+    return {"runs": runs, **({"median": statistics.median(seconds), "min": min(seconds)}
+                             if seconds else {}), **({"errors": errors} if errors else {})}
 
 
 def run(quick: bool, output: Path, python_path: Path | None = None,
@@ -116,13 +112,10 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
 
 def _ratios(warm: dict[str, Any], entries: Sequence[str]) -> dict[str, float]:
     """Warm median of every case over Acrobot-v1's in the same entry."""
-    ratios = {}
-    for entry in entries:
-        reference = warm.get(f"Acrobot-v1 {entry}", {}).get("median")
-        for key, summary in warm.items():
-            if key.endswith(f" {entry}") and reference and "median" in summary:
-                ratios[key] = summary["median"] / reference
-    return ratios
+    references = {entry: warm.get(f"Acrobot-v1 {entry}", {}).get("median") for entry in entries}
+    return {key: summary["median"] / references[entry] for entry in entries
+            for key, summary in warm.items()
+            if key.endswith(f" {entry}") and references[entry] and "median" in summary}
 
 
 def _targets(record: dict[str, Any], env_ids: Sequence[str],

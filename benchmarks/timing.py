@@ -28,6 +28,9 @@ import numpy as np
 
 from mdi_envs.provenance import git_commit
 
+Log = Callable[[str], None]
+"""A progress log: one call per line."""
+
 
 @dataclass(frozen=True)
 class TimingPlan:
@@ -100,10 +103,10 @@ def fresh_python(*args: str, cwd: Path = ROOT, **env: str | None
 
 
 def probe_first_calls(cold: bool) -> dict[str, Any]:
-    """Run ``benchmarks.first_call`` in a fresh interpreter and return its JSON report."""
+    """Run ``benchmarks.probes first-call`` in a fresh interpreter and return its JSON report."""
     with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache_dir:
         cache = cache_dir if cold else None  # numba's cache, and the package's own
-        process = fresh_python("-m", "benchmarks.first_call", NUMBA_CACHE_DIR=cache,
+        process = fresh_python("-m", "benchmarks.probes", "first-call", NUMBA_CACHE_DIR=cache,
                                MDI_ENVS_CACHE_DIR=cache)
     if process.returncode != 0:
         return {"error": process.stderr.strip().splitlines()[-1:]}

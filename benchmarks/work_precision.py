@@ -22,7 +22,7 @@ import numpy as np
 from benchmarks import engine_mujoco as mj
 from benchmarks import report, timing
 from benchmarks.report import format_number, log_lines, plt, save_figure, summary
-from benchmarks.timing import Progress, TimingPlan
+from benchmarks.timing import Log, TimingPlan
 from mdi_envs import stepping
 from mdi_envs.mechanics import models
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
@@ -31,7 +31,6 @@ from mdi_envs.solvers.status import SolverStatus
 from mdi_envs.stepping._kernel import INFO_STATUS
 from mdi_envs.stepping.event_driven import EVENT_APEX, EVENT_IMPACT, Trajectory
 
-Log = Callable[[str], None]
 METHODS = {"enumerative": stepping.StepShortcuts(),
            "lemke": stepping.StepShortcuts(direct_solve_max_size=0)}
 ATOL_PER_RTOL = 1e-2  # event-driven runs: atol = ATOL_PER_RTOL * rtol
@@ -307,21 +306,19 @@ def ball_event_errors(p: BouncingBallParameters, gaps: np.ndarray, runs: list[Tr
     return _ball_summary(per_drop)
 
 
-def _ball_setup(ctx: Context) -> tuple[BouncingBallParameters, WorkPrecisionConfig, np.ndarray,
-                                      float]:
-    """The ball's parameters, the run's configuration, the drops' gaps [m] and the horizon [s]."""
-    # the drops' initial gaps h0 [m], U(0.9, 1.1) with seed 0
+def _ball_setup(ctx: Context) -> tuple[BouncingBallParameters, np.ndarray, float]:
+    """The ball's parameters, the drops' initial gaps h0 [m] (U(0.9, 1.1), seed 0), horizon [s]."""
     p, gaps = BouncingBallParameters(), np.random.default_rng(0).uniform(0.9, 1.1,
                                                                          ctx.config.ball_drops)
-    return p, ctx.config, gaps, ball_horizon(p, gaps)
+    return p, gaps, ball_horizon(p, gaps)
 
 
 def ball_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
     """Moreau-Jean ball points: per method and dt, drop 0 timed, D drops replayed step by step."""
-    p, config, gaps, horizon = _ball_setup(ctx)
-    variants = [(f"mj_{method}", method, False) for method in config.methods]
+    p, gaps, horizon = _ball_setup(ctx)
+    variants = [(f"mj_{method}", method, False) for method in ctx.config.methods]
     for series, method, locate_impacts in [*variants, ("mj_located", "enumerative", True)]:
-        for dt in config.ball_time_steps:
+        for dt in ctx.config.ball_time_steps:
             st = ctx.stepper(models.BouncingBall, p, dt, method, locate_impacts)
             num_steps = math.ceil(horizon / dt)
             q0 = np.column_stack([np.zeros(gaps.size), p.radius + gaps])  # at rest
@@ -341,8 +338,8 @@ def ball_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
 
 def ball_event_driven(ctx: Context) -> Iterator[dict[str, Any]]:
     """Event-driven ball points: per rtol, drop 0 timed, every drop's events compared."""
-    p, config, gaps, horizon = _ball_setup(ctx)
-    for rtol in config.tolerances:
+    p, gaps, horizon = _ball_setup(ctx)
+    for rtol in ctx.config.tolerances:
         options = {"rtol": rtol, "atol": ATOL_PER_RTOL * rtol}
         wall, repeats, _ = ctx.timed(partial(stepping.simulate_ball, p, p.radius + gaps[0], horizon,
                                              **options))
@@ -354,10 +351,9 @@ def ball_event_driven(ctx: Context) -> Iterator[dict[str, Any]]:
 
 def ball_mujoco(ctx: Context) -> Iterator[dict[str, Any]]:
     """MuJoCo ball points per dampratio mapping and dt (the calibrations into ``ctx``)."""
-    p, config, gaps, horizon = _ball_setup(ctx)
-    calibrations = []
-    for series in config.mujoco_ball_series:
-        for dt in config.mujoco_ball_time_steps:
+    p, gaps, horizon = _ball_setup(ctx)
+    for series in ctx.config.mujoco_ball_series:
+        for dt in ctx.config.mujoco_ball_time_steps:
             name = f"mujoco_{series}"
             dampratio, note = ((mj.formula_dampratio(p.restitution), "damped-oscillator formula")
                                if series == "formula" else
@@ -368,9 +364,9 @@ def ball_mujoco(ctx: Context) -> Iterator[dict[str, Any]]:
                 continue
             ball = mj.MujocoBall(ctx.mujoco, p, dt, dampratio)
             restitution = ball.effective_restitution()
-            calibrations.append({"series": name, "dt": dt, "dampratio": dampratio,
-                                 "effective_restitution": restitution, "note": note,
-                                 **ball.contact_settings})
+            ctx.calibrations.append({"series": name, "dt": dt, "dampratio": dampratio,
+                                     "effective_restitution": restitution, "note": note,
+                                     **ball.contact_settings})
             num_steps = math.ceil(horizon / dt)
             wall, repeats, final = ctx.timed(partial(ball.run, float(gaps[0]), num_steps))
             y, v = ball.trajectories(gaps, num_steps)
@@ -379,7 +375,6 @@ def ball_mujoco(ctx: Context) -> Iterator[dict[str, Any]]:
                 ctx.log, "ball", name, "dt", dt, wall, repeats, "mujoco_one_call",
                 ball_errors(p, gaps, y, v, dt), replay_difference=float(difference),
                 dampratio=dampratio, effective_restitution=restitution)
-    ctx.calibrations = calibrations
 
 
 def stick_slip_closed_form(theta: float, mu: float, mass: float, rate: float, gravity: float
@@ -654,42 +649,30 @@ def _section(ctx: Context, name: str, study: Callable[[Context], Iterable[dict[s
 def run(output: Path, quick: bool, log: Log | None = None,
         config: WorkPrecisionConfig | None = None) -> dict[str, Any]:
     """Run the benchmark, write the JSON and plots to ``output`` and return the record."""
-    progress = Progress()
-    log = log or progress
     config = config or (QUICK if quick else FULL)
-    output.mkdir(parents=True, exist_ok=True)
-    mujoco, mujoco_note = mj.import_mujoco()
-    ctx = Context(config, log, mujoco)
-    if mujoco_note:
-        ctx.notes.append(mujoco_note)
-    record: dict[str, Any] = {
-        "machine": timing.machine_info((*timing.VERSIONED_PACKAGES, "mujoco")),
-        "config": {"quick": quick, **asdict(config)},
-        "timed_paths": TIMED_PATHS,
-    }
-    log(f"work-precision benchmark ({'quick' if quick else 'full'}) -> {output}")
-    points: list[dict[str, Any]] = []
-    for scene, studies in STUDIES.items():
-        if scene not in config.scenes:
-            continue
-        if scene == "manipulator":
-            manipulator_reference(ctx)
-        for name, study in studies:
-            if "MuJoCo" not in name or mujoco is not None:
-                points += _section(ctx, name, study)
-    targets, comparison = evaluate_targets(points)
-    record.update({"compile": ctx.compile, "points": points, "references": ctx.references,
-                   "mujoco_ball_calibration": ctx.calibrations,
-                   "equal_time": comparison, "targets": targets, "notes": ctx.notes,
-                   "failed_sections": ctx.failed_sections})
-    timing.finish(record, progress.elapsed)
-    scenes = [s for s in config.scenes if any(p["scene"] == s for p in points)]
-    record["plots"] = plot_all(points, scenes, output)
-    record = report.json_safe(record)
-    report.write_json(record, output / "work_precision.json")
-    log(f"done in {progress.elapsed:.0f} s; wrote work_precision.json and "
-        f"{len(record['plots'])} plots to {output}")
-    return record
+    packages = (*timing.VERSIONED_PACKAGES, "mujoco")
+    with report.study("work_precision", output, {"quick": quick, **asdict(config)}, packages,
+                      log=log) as (record, log, _):
+        mujoco, mujoco_note = mj.import_mujoco()
+        ctx = Context(config, log, mujoco, notes=[mujoco_note] if mujoco_note else [])
+        record["timed_paths"] = TIMED_PATHS
+        points: list[dict[str, Any]] = []
+        for scene, studies in STUDIES.items():
+            if scene not in config.scenes:
+                continue
+            if scene == "manipulator":
+                manipulator_reference(ctx)
+            for name, study in studies:
+                if "MuJoCo" not in name or mujoco is not None:
+                    points += _section(ctx, name, study)
+        targets, comparison = evaluate_targets(points)
+        record.update({"compile": ctx.compile, "points": points, "references": ctx.references,
+                       "mujoco_ball_calibration": ctx.calibrations,
+                       "equal_time": comparison, "targets": targets, "notes": ctx.notes,
+                       "failed_sections": ctx.failed_sections})
+        scenes = [s for s in config.scenes if any(p["scene"] == s for p in points)]
+        record["plots"] = plot_all(points, scenes, output)
+    return report.json_safe(record)
 
 
 def series_title(series: str) -> str:

@@ -232,7 +232,7 @@ def benchmark_page() -> None:
                   "(`benchmarks/results/headline.json`, `benchmarks.report.targets_table`).", ""]
         for name in dict.fromkeys(r["benchmark"] for r in rows):
             lines += [f"**{name}**", "", clean(targets_table(
-                [r for r in rows if r["benchmark"] == name])), ""]
+                [{**r, "benchmark": None} for r in rows if r["benchmark"] == name])), ""]
     for stem, (title, command) in BENCHMARKS.items():
         path = folder / f"{stem}.json"
         if not path.exists():
