@@ -33,6 +33,19 @@ def test_on_the_reference_the_plan_is_the_reference(controller: TrackingMPC) -> 
     assert controller.fallbacks == []
 
 
+def test_every_window_solved_from_the_references_state_gives_its_multipliers(
+        controller: TrackingMPC) -> None:
+    """The stored multipliers (the start of a first or window-changing step) are a solution's.
+
+    A failed solve would leave zeros; each window has at least one nearly active inequality
+    (a torque bound or a contact law), whose multiplier is not zero.
+    """
+    for key, multipliers in zip(controller._keys, controller._reference_multipliers,
+                                strict=True):
+        assert multipliers.shape == (controller._windows[key].num_multipliers,)
+        assert np.all(np.isfinite(multipliers)) and np.any(multipliers != 0.0)
+
+
 def test_from_a_perturbed_start_it_reaches_the_goal_in_the_optimal_time(
         controller: TrackingMPC) -> None:
     reference = controller.reference
