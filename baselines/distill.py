@@ -10,8 +10,9 @@ configuration (one env step per transcription interval of the reference):
 - rounds 1 ... ``rounds``: episodes from new perturbed starts are played by the mixture that
   takes the expert's action with probability beta_i = ``beta_decay`` ** i at each step and the
   learner's otherwise; every visited state is labelled with the expert's action (the expert is
-  called at every step, so its step counter follows the episode), added to the data, and the
-  learner is trained further on all of it (``gradient_steps`` Adam steps on random
+  called at every step, so its step counter follows the episode, and told the learner's
+  torques when they are played, so a friction estimate follows the robot), added to the data,
+  and the learner is trained further on all of it (``gradient_steps`` Adam steps on random
   minibatches, the learning rate decaying from ``learning_rate`` to a tenth in each round).
 
 After each round the learner plays ``validation`` perturbed starts alone (the same starts every
@@ -254,8 +255,12 @@ def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, l
         labels.calls += 1
         labels.observations.append(np.asarray(observation, dtype=np.float32))
         labels.actions.append(label)
-        flat = label if rng.random() < beta else learner.policy.predict(
-            observation, deterministic=True)[0]  # fmt: skip
+        if rng.random() < beta:
+            flat = label
+        else:
+            flat = learner.policy.predict(observation, deterministic=True)[0]
+            if hasattr(policy, "applied"):  # an expert whose state follows the torques played
+                policy.applied(flat)
         observation, reward, terminated, truncated, info = env.step(native_action(flat, hybrid))
         done = terminated or truncated
         for key, value in (("observations", observation), ("actions", action),

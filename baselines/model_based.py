@@ -125,6 +125,11 @@ class Recovering:
         self._step += 1
         return (self.tracker if self.recovery is None else self.recovery)(observation)
 
+    def applied(self, action: Any) -> None:
+        """The tracker's ``StateFeedbackPolicy.applied`` while it acts (the follower keeps none)."""
+        if self.recovery is None:
+            self.tracker.applied(action)
+
 
 def tracking_state_controller(env_id: str, objective: str) -> Controller | None:
     """The tracking MPC, state-indexed (``INDEX_WINDOW``) and without ``Recovering``.

@@ -85,6 +85,14 @@ class StateFeedbackPolicy:
         """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u)."""
         raise NotImplementedError
 
+    def applied(self, action: FloatArray) -> None:
+        """Note that ``action`` was played after the last call instead of this policy's own.
+
+        ``action``: the env action played, its first m entries the torques over
+        ``torque_bound`` (the brake entries are not read). A policy whose state follows the
+        applied torques overrides it (``TrackingMPC``'s friction estimate); here nothing to note.
+        """
+
     def is_state_indexed(self) -> bool:
         """Whether this call's step is the state's ``nearest_node`` (else the call count)."""
         return bool(self.index_window)

@@ -209,6 +209,13 @@ class TrackingMPC(StateFeedbackPolicy):
         self._measured = (q, u, tau)
         return tau, brake
 
+    def applied(self, action: FloatArray) -> None:
+        """The friction estimate's next update takes the torques of ``action`` (the base's)."""
+        if self._measured is not None:
+            q, u, tau = self._measured
+            torques = np.clip(np.asarray(action[:tau.size], dtype=float), -1.0, 1.0)
+            self._measured = (q, u, torques * self.torque_bound)
+
     def _control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
         """``control`` without recording the step."""
         extra = []

@@ -141,3 +141,29 @@ def test_on_a_floor_with_less_grip_the_robots_tracker_adapts_and_follows_the_pat
     assert controller.is_state_indexed()
     controller.reset()
     assert controller.traction.factor == 1.0 and not controller.is_state_indexed()
+
+
+def test_the_robots_tracker_estimates_friction_from_the_torques_played() -> None:
+    """A step played with other torques than the tracker's (a learner's, in a DAgger mixture).
+
+    Told those torques (``applied``), it finds the floor's 20 % less grip from the step; fed its
+    own, no friction factor explains the step and the estimate stays at the model's.
+    """
+    from mdi_envs.stepping import MoreauJeanStepper
+    from optimal.problems import make_problem, model_of
+    from optimal.traction import scaled_friction
+
+    reference = load_reference("diff_drive_time")
+    controller = TrackingMPC(reference, horizon=3)
+    model, parameters = model_of(make_problem(reference.name))
+    floor = MoreauJeanStepper(model, scaled_friction(parameters, 0.8), reference.time_step)
+    q, u = reference.q[0], reference.u[0]
+    for told, factor in ((True, 0.8), (False, 1.0)):
+        controller.reset()
+        tau, _ = controller.control(0, q, u)
+        played = 0.5 * tau
+        step = floor.step(q, u, played)
+        if told:
+            controller.applied(played / controller.torque_bound)
+        controller.control(1, step.q, step.u)
+        assert controller.friction_factors[1] == pytest.approx(factor, abs=1e-6)
