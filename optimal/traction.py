@@ -68,7 +68,7 @@ class FrictionEstimator:
         self._weight = np.asarray(weight, dtype=float)
         self._steps: deque[tuple[FloatArray, FloatArray, FloatArray, FloatArray]] = deque(
             maxlen=WINDOW)
-        self._errors: deque[FloatArray] = deque(maxlen=WINDOW)
+        self._errors: deque[FloatArray | None] = deque(maxlen=WINDOW)
         self.factor = 1.0
 
     def reset(self) -> None:
@@ -78,14 +78,23 @@ class FrictionEstimator:
         self.factor = 1.0
 
     def update(self, q: FloatArray, u: FloatArray, tau: FloatArray, u_next: FloatArray) -> float:
-        """The estimate after a measured step: (q, u) under ``tau`` to velocities ``u_next``."""
+        """The estimate after a measured step: (q, u) under ``tau`` to velocities ``u_next``.
+
+        The grid's errors of a step are computed when first needed: while the estimate's own
+        error is within the tolerance of zero, no factor's is smaller by more.
+        """
         self._steps.append((q, u, tau, u_next))
-        self._errors.append(np.array([self._error(stepper, *self._steps[-1])
-                                      for stepper in self._steppers]))
-        steps = len(self._steps)
+        self._errors.append(None)
+        steps, error = len(self._steps), self.window_error(self.factor)
+        if error <= TOLERANCE * steps:
+            return self.factor
+        for i, step in enumerate(self._steps):
+            if self._errors[i] is None:
+                self._errors[i] = np.array([self._error(stepper, *step)
+                                            for stepper in self._steppers])
         grid = np.sum(self._errors, axis=0)
         best = grid.min() + TOLERANCE * steps
-        if self.window_error(self.factor) <= best:
+        if error <= best:
             return self.factor
         candidates = FACTORS[grid <= best]
         center = float(candidates[np.argmin(np.abs(candidates - self.factor))])
