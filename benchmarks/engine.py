@@ -264,6 +264,7 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
         on_arrays = batch_arrays(case, n, [case.scene(sc.scene)])
         on = _batched_entry(steppers[case.label], on_arrays, config.call_s,
                             config.scene_min_substeps)
+        difference: float | None = None
         if isinstance(sc.off, StepShortcuts):
             key = (case.label, sc.off)
             if key not in variants:
@@ -271,18 +272,13 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
             off = BatchedCall(variants[key], on_arrays, on.num_substeps)
             on()  # both from the same initial states: the largest |state difference|
             off()
-            difference: float | None = float(max(np.abs(on.q - off.q).max(),
-                                                 np.abs(on.u - off.u).max()))
-            off_scene = sc.scene
+            difference = float(max(np.abs(on.q - off.q).max(), np.abs(on.u - off.u).max()))
         else:
-            off = _batched_entry(steppers[case.label],
-                                 batch_arrays(case, n, [case.scene(sc.off)]), config.call_s,
-                                 config.scene_min_substeps)
-            difference = None
-            off_scene = sc.off
+            off = _batched_entry(steppers[case.label], batch_arrays(case, n, [case.scene(sc.off)]),
+                                 config.call_s, config.scene_min_substeps)
         timed = timing.time_interleaved({"on": on, "off": off}, config.shortcut_plan)
         row = {"shortcut": sc.shortcut, "model": sc.model, "scene": sc.scene,
-               "off_scene": off_scene,
+               "off_scene": sc.off if isinstance(sc.off, str) else sc.scene,
                "off_shortcuts": sc.off._asdict() if isinstance(sc.off, StepShortcuts) else None,
                "on": _per_copy_step(timed["on"].summary(), n, on.num_substeps),
                "off": _per_copy_step(timed["off"].summary(), n, off.num_substeps),

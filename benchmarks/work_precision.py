@@ -258,13 +258,9 @@ def _ball_summary(per_drop: list[tuple[np.ndarray, float] | str]) -> dict[str, A
                 "status": f"failed: {len(per_drop) - len(done)} of {len(per_drop)} drops: "
                           + "; ".join(reasons)}
     worst = np.array([d[0].max() for d in done])
-    return {
-        "error": float(worst.mean()),
-        "error_max": float(worst.max()),
-        "apex_error_by_bounce": [float(x) for x in np.mean([d[0] for d in done], axis=0)],
-        "impact_time_error_s": float(np.mean([d[1] for d in done])),
-        "failed_drops": 0,
-    }
+    return {"error": float(worst.mean()), "error_max": float(worst.max()),
+            "apex_error_by_bounce": [float(x) for x in np.mean([d[0] for d in done], axis=0)],
+            "impact_time_error_s": float(np.mean([d[1] for d in done])), "failed_drops": 0}
 
 
 def ball_errors(p: BouncingBallParameters, gaps: np.ndarray, y: np.ndarray, v: np.ndarray,
@@ -685,8 +681,7 @@ def series_title(series: str) -> str:
 def pareto_front(points: Sequence[Mapping[str, Any]]) -> list[tuple[float, float, str]]:
     """(wall time [s], error, label) of the points no other point beats in both, by time."""
     usable = sorted((p["wall_time_s"], p["error"], f"{p['series']} dt={p['value']:g}")
-                    for p in points
-                    if p.get("error") is not None and p["wall_time_s"] is not None)
+                    for p in points if p.get("error") is not None and p["wall_time_s"] is not None)
     front: list[tuple[float, float, str]] = []
     for seconds, error, label in usable:
         if not front or error < front[-1][1]:
@@ -729,13 +724,10 @@ def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
     bounds = [r["ratio"] for r in rows if r["ratio"] is not None and r["how"] == "clamped"]
     at_1ms = next((r for r in rows if math.isclose(r["dt"], 1e-3)), None)
     result: dict[str, Any] = {
-        "rows": rows, "front": [list(f) for f in front],
-        "min_ratio": min(ratios) if ratios else None,
-        "max_ratio": max(ratios) if ratios else None,
-        "min_equal_time_ratio": min(equal) if equal else None,
-        "min_lower_bound_ratio": min(bounds) if bounds else None,
-        "ratio_at_1ms": None if at_1ms is None else at_1ms["ratio"],
-    }
+        "rows": rows, "front": [list(f) for f in front], "min_ratio": min(ratios, default=None),
+        "max_ratio": max(ratios, default=None), "min_equal_time_ratio": min(equal, default=None),
+        "min_lower_bound_ratio": min(bounds, default=None),
+        "ratio_at_1ms": None if at_1ms is None else at_1ms["ratio"]}
     parts = [f"{text} {format_number(min(ratios))}–{format_number(max(ratios))}× over "
              f"{len(ratios)} of our dt" for text, ratios in (
                  ("at equal time (interpolated)", equal),
