@@ -139,11 +139,6 @@ class BatchedCall:
             self.q, self.u, self.initial[2], self.initial[3])
         self.out = (self.initial_impulses.copy(), info)
 
-    @property
-    def num_copies(self) -> int:
-        """N."""
-        return self.initial[0].shape[0]
-
     def with_substeps(self, num_substeps: int) -> BatchedCall:
         """This call, set to ``num_substeps`` substeps."""
         self.num_substeps = num_substeps

@@ -246,15 +246,14 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Log
         if not loops:
             continue
         measured = []
+        rates = (("", "median"), ("_q1", "q3"), ("_q3", "q1"), ("_best", "min"))  # time quantile
         for key, value in timing.time_interleaved(loops, config.vector_plan).items():
-            summary = value.summary()
-            rates = (("", "median"), ("_q1", "q3"), ("_q3", "q1"), ("_best", "min"))
+            times, skip = value.summary(), meta[key]["frame_skip"]
             measured.append({
-                **meta[key], "call": summary,
-                **{f"env_steps_per_s{k}": n / summary[f"{stat}_s"] for k, stat in rates},
-                "per_env_step_us": summary["median_s"] / n * 1e6,
-                **{f"physics_steps_per_s{k}": n / summary[f"{stat}_s"] * meta[key]["frame_skip"]
-                   for k, stat in rates}})
+                **meta[key], "call": times,
+                **{f"env_steps_per_s{k}": n / times[f"{stat}_s"] for k, stat in rates},
+                "per_env_step_us": times["median_s"] / n * 1e6,
+                **{f"physics_steps_per_s{k}": n / times[f"{stat}_s"] * skip for k, stat in rates}})
             loops[key].env.close()
         rows += measured
         log(f"vector N = {n}: " + ", ".join(
@@ -266,17 +265,14 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Log
 def evaluate_targets(single: Sequence[dict[str, Any]], vector: Sequence[dict[str, Any]]
                      ) -> list[dict[str, Any]]:
     """The targets against the measurements (``met`` None where not measured)."""
-    by_id = {r["env_id"]: r for r in single}
-    manipulator = by_id.get(MANIPULATOR)
+    manipulator = next((r for r in single if r["env_id"] == MANIPULATOR), None)
     step = manipulator["gym.make"]["median_us"] if manipulator else None
     targets = [report.target_row("manipulator env.step through gym.make (median)", "≤",
                             TARGETS["manipulator_step_us"], "µs", step,
                             "" if step is None else
                             f"fastest rounds {manipulator['gym.make']['min_us']:.1f} µs, "
                             f"unwrapped {manipulator['unwrapped']['median_us']:.1f} µs")]
-    for record in single:
-        if not record["ours"]:
-            continue
+    for record in (r for r in single if r["ours"]):
         ratio = record["ratios"].get(ACROBOT)
         targets.append(report.target_row(
             f"{short_name(record['env_id'])} env.step ≥ 3× faster than {ACROBOT} "

@@ -223,11 +223,9 @@ def stress_row(record: dict[str, Any]) -> dict[str, Any]:
 
 def engine_peer_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
     """Ours against MuJoCo's arm in the engine run."""
-    rows = []
-    largest: dict[str, dict[str, Any]] = {}
-    for entry in record.get("batched") or []:
-        if entry["copies"] >= largest.get(entry["model"], {}).get("copies", 0):
-            largest[entry["model"]] = entry
+    rows = []  # each model's row at its largest N (the last of equals)
+    batched = sorted(record.get("batched") or [], key=lambda entry: entry["copies"])
+    largest = {entry["model"]: entry for entry in batched}
     if "manipulator" in largest and "mujoco" in largest:
         ours, peer = largest["manipulator"]["per_copy_step_s"], largest["mujoco"]["per_copy_step_s"]
         rows.append(target_row(

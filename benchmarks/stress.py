@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -19,7 +18,7 @@ import numpy as np
 import pytest
 
 from benchmarks import report
-from benchmarks.timing import arguments, load_average, machine_info
+from benchmarks.timing import arguments
 
 TESTS = Path(__file__).resolve().parents[1] / "tests" / "stress"  # The folder of the stress cases.
 MARGIN_FLOOR, MARGIN_CEILING = 1e-9, 1e9
@@ -44,27 +43,21 @@ class _Collector:
 
 def run(output: Path, quick: bool) -> dict[str, Any]:
     """Run every stress case, write ``stress.json`` and ``stress.png`` to ``output``."""
-    start = time.perf_counter()
-    machine = machine_info()
-    collector = _Collector()
-    os.environ["MDI_ENVS_STRESS"] = "quick" if quick else "full"
-    code = pytest.main([str(TESTS), "-q", "-m", "stress", "-p", "no:cacheprovider"],
-                       plugins=[collector])
-    cases = collector.cases
-    machine["load_average_at_end"] = load_average()
-    record: dict[str, Any] = {
-        "machine": machine, "config": collector.run.get("config"),
-        "notes": collector.run.get("notes", []), "cases": cases,
-        "passed": bool(cases) and all(c["passed"] for c in cases), "num_cases": len(cases),
-        "num_failed": sum(not c["passed"] for c in cases),
-        "compile_s": collector.run.get("compile_s", {}),
-        "run_time_s": time.perf_counter() - start}
-    if code not in (pytest.ExitCode.OK, pytest.ExitCode.TESTS_FAILED):
-        record["passed"], record["pytest_exit_code"] = False, int(code)
-    output.mkdir(parents=True, exist_ok=True)
-    if cases:
-        plot_margins(cases, output / "stress.png")
-    report.write_json(report.json_safe(record), output / "stress.json")
+    with report.study("stress", output, {"quick": quick}) as (record, _, _):
+        collector = _Collector()
+        os.environ["MDI_ENVS_STRESS"] = "quick" if quick else "full"
+        code = pytest.main([str(TESTS), "-q", "-m", "stress", "-p", "no:cacheprovider"],
+                           plugins=[collector])
+        cases = collector.cases
+        record.update({
+            "config": collector.run.get("config"), "notes": collector.run.get("notes", []),
+            "cases": cases, "passed": bool(cases) and all(c["passed"] for c in cases),
+            "num_cases": len(cases), "num_failed": sum(not c["passed"] for c in cases),
+            "compile_s": collector.run.get("compile_s", {})})
+        if code not in (pytest.ExitCode.OK, pytest.ExitCode.TESTS_FAILED):
+            record["passed"], record["pytest_exit_code"] = False, int(code)
+        if cases:
+            plot_margins(cases, output / "stress.png")
     return record
 
 
