@@ -126,15 +126,15 @@ def measure(key: str, env_id: str, objective: str, starts: int, progress: Progre
 def memory_growth(steps: int, progress: Progress) -> dict[str, Any]:
     """Peak resident memory growth over ``steps`` control steps in which no plan is found.
 
-    The tracking MPC on the manipulator with IPOPT limited to one iteration, so every step's
-    window solve fails and the LQR's control is applied; episodes from 0.1-perturbed starts
-    are played until ``steps`` steps have been taken after the first episode's first
-    ``MEMORY_WARMUP`` steps (``resource.getrusage``'s peak RSS, before and after).
+    The tracking MPC on the manipulator with IPOPT limited to one iteration and no acceptable
+    stop, so every step's window solve fails and the LQR's control is applied; episodes from
+    0.1-perturbed starts are played until ``steps`` steps have been taken after the first
+    episode's first ``MEMORY_WARMUP`` steps (``resource.getrusage``'s peak RSS, before and after).
     """
     from optimal.tracking import TrackingMPC
 
     reference = load_reference("manipulator_time")
-    controller = TrackingMPC(reference, max_iterations=1)
+    controller = TrackingMPC(reference, max_iterations=1, solver_options={"acceptable_iter": 0})
     options = {**row_env_options(reference), "reset_noise_scale": 0.1}
     env = gym.make(reference.metadata["env_id"], **options)
     taken, seed, start = 0, 0, None

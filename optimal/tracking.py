@@ -29,7 +29,9 @@ plan's last interval instead breaks the dynamics there, from where IPOPT converg
 minima of the window far off the reference). The first step and a step into another window
 pattern take the multipliers of that window solved from the reference's state (computed in the
 constructor): an interior-point start needs the multipliers of its nearly active inequalities,
-which zeros are not. IPOPT runs from a small barrier
+which zeros are not; with ``WARM_START_PUSH`` the start stays on those inequalities, the
+window from the reference's point does not converge, and the multipliers are zeros. IPOPT runs
+from a small barrier
 parameter to a loose tolerance (``SOLVER_OPTIONS``) and at most ``MAX_ITERATIONS`` iterations;
 if it fails, the LQR's control is applied (``fallbacks``) and its last iterate is dropped.
 
@@ -50,9 +52,13 @@ Speed (CPU time per control step over one 0.1-perturbed episode of each task):
   4 / 6, manipulator 15 / 23 instead of 17 / 25; the time reached is the same and the effort
   0.03 % higher.
 - The multipliers of the window solved from the reference's state as the start of a first or
-  window-changing step (instead of zeros): on the robot's time task (seeds 1 and 2), 28-32 %
-  less CPU time per episode, 95th percentile of the iterations per step 9 and 16 instead of 12
-  and 16.
+  window-changing step (instead of zeros): on the effort task 2.4x less CPU time per episode,
+  iterations per step, median / 95th percentile, 2 / 3 instead of 6 / 21.
+- Warm-start pushes of 1e-6 instead of 1e-3 (``WARM_START_PUSH``: the shifted plan stays where
+  it was) on the manipulator and the robot's time task: iterations per step, median / 95th
+  percentile, manipulator 4 / 11 instead of 15 / 23, robot (two episodes) 1 / 8 and 2 / 6
+  instead of 3 / 14 and 2 / 16, the same arrival times; on the effort task, whose 40-interval
+  window then takes 13 / 41 and falls back 5 times in 100 steps, IPOPT's own.
 - The NLP functions are not compiled (CasADi JIT): their evaluations (``nlp_f``, ``nlp_g``,
   their derivatives and the Hessian) are under 10 % of a step, the rest is IPOPT and its
   linear solver.
@@ -97,6 +103,11 @@ SOLVER_OPTIONS = {"print_level": 0, "sb": "yes", "tol": 1e-4, "acceptable_tol": 
                   "acceptable_iter": 1, "mu_init": 1e-4, "warm_start_init_point": "yes"}
 """IPOPT's options besides the iteration limit (see the module docstring on speed)."""
 
+WARM_START_PUSH = {"manipulator_time": 1e-6, "diff_drive_time": 1e-6}
+"""IPOPT's warm-start pushes into the interior (``warm_start_bound_push``, ``_bound_frac``,
+``_slack_bound_push``, ``_slack_bound_frac``, ``_mult_bound_push``) per reference, IPOPT's own
+(1e-3) for the others (see the module docstring on speed)."""
+
 
 @dataclasses.dataclass
 class _Window:
@@ -114,7 +125,8 @@ class TrackingMPC(StateFeedbackPolicy):
     Args:
         reference: the reference tracked; its grid step h must be the env's dt.
         horizon: intervals of the window (None: ``HORIZON``). max_iterations: see
-            ``MAX_ITERATIONS``.
+            ``MAX_ITERATIONS``. solver_options: IPOPT options over ``SOLVER_OPTIONS`` and
+            ``WARM_START_PUSH``.
 
     Attributes:
         lqr: the ``TimeVaryingLQR`` whose weights, fallback control and ``node_states``,
@@ -130,10 +142,16 @@ class TrackingMPC(StateFeedbackPolicy):
     """
 
     def __init__(self, reference: Reference, horizon: int | None = None,
-                 max_iterations: int = MAX_ITERATIONS) -> None:
+                 max_iterations: int = MAX_ITERATIONS,
+                 solver_options: dict[str, Any] | None = None) -> None:
         self.reference = reference
         self.horizon = int(horizon or HORIZON.get(reference.name, DEFAULT_HORIZON))
         self.max_iterations = int(max_iterations)
+        push = WARM_START_PUSH.get(reference.name)
+        self.solver_options = {**SOLVER_OPTIONS, **({} if push is None else {
+            f"warm_start_{name}": push for name in ("bound_push", "bound_frac", "slack_bound_push",
+                                                    "slack_bound_frac", "mult_bound_push")}),
+                               **(solver_options or {}), "max_iter": self.max_iterations}
         self.lqr = TimeVaryingLQR(reference)
         self.node_states, self.node_weight = self.lqr.node_states, self.lqr.node_weight
         self.base = make_problem(reference.name, len(reference.tau))
@@ -166,8 +184,9 @@ class TrackingMPC(StateFeedbackPolicy):
         self._windows: dict[bytes, _Window] = {}
         self._keys = [self._window(k) for k in range(steps + (1 if extension else 0))]
         self._reference_points = [self._reference_point(k) for k in range(len(self._keys))]
-        self._reference_multipliers = [self._reference_multiplier(k)
-                                       for k in range(len(self._keys))]
+        self._reference_multipliers = [
+            self._reference_multiplier(k) if reference.name not in WARM_START_PUSH
+            else np.zeros(self._windows[key].num_multipliers) for k, key in enumerate(self._keys)]
         self.compute_times: list[float] = []
         self.fallbacks: list[int] = []
         self.iterations: list[int] = []
@@ -284,7 +303,7 @@ class TrackingMPC(StateFeedbackPolicy):
         effort_unit = problem.torque_bound**2 * problem.final_time
         opti.minimize(opti.f - t.cost / effort_unit + tracking / big_h)
         opti.solver("ipopt", {"expand": True, "print_time": False, "error_on_fail": False},
-                    {**SOLVER_OPTIONS, "max_iter": self.max_iterations})
+                    self.solver_options)
         q0, u0 = t._start
         opti.set_value(t.rho, 0.0)
         opti.set_value(t.relaxation, POLISH_RELAXATION)
@@ -350,4 +369,5 @@ def _reference_modes(reference: Reference) -> tuple[np.ndarray | None, np.ndarra
     return modes.engaged, modes.sliding
 
 
-__all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "SOLVER_OPTIONS", "TrackingMPC"]
+__all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "SOLVER_OPTIONS", "WARM_START_PUSH",
+           "TrackingMPC"]

@@ -33,13 +33,14 @@ def test_on_the_reference_the_plan_is_the_reference(controller: TrackingMPC) -> 
     assert controller.fallbacks == []
 
 
-def test_every_window_solved_from_the_references_state_gives_its_multipliers(
-        controller: TrackingMPC) -> None:
+def test_every_window_solved_from_the_references_state_gives_its_multipliers() -> None:
     """The stored multipliers (the start of a first or window-changing step) are a solution's.
 
-    A failed solve would leave zeros; each window has at least one nearly active inequality
-    (a torque bound or a contact law), whose multiplier is not zero.
+    On the robot's effort reference (IPOPT's own warm-start pushes). A failed solve would leave
+    zeros; each window has at least one nearly active inequality (a torque bound or a contact
+    law), whose multiplier is not zero.
     """
+    controller = TrackingMPC(load_reference("diff_drive_effort"), horizon=3)
     for key, multipliers in zip(controller._keys, controller._reference_multipliers,
                                 strict=True):
         assert multipliers.shape == (controller._windows[key].num_multipliers,)
@@ -93,13 +94,14 @@ def test_the_warm_start_shifts_every_variable_by_whole_intervals() -> None:
 def test_steps_without_a_plan_keep_no_memory() -> None:
     """Without a plan at any step, the peak resident memory stays where the first steps left it.
 
-    IPOPT is held to one iteration, so every step falls back to the LQR; the NLPs are built
-    once, nothing per step.
+    IPOPT is held to one iteration without an acceptable stop, so every step falls back to the
+    LQR; the NLPs are built once, nothing per step.
     """
     import gymnasium as gym
 
     reference = load_reference("manipulator_time")
-    controller = TrackingMPC(reference, horizon=4, max_iterations=1)
+    controller = TrackingMPC(reference, horizon=4, max_iterations=1,
+                             solver_options={"acceptable_iter": 0})
     options = env_options(reference)
     options.update(reset_noise_scale=0.1, max_episode_steps=2 * len(reference.tau))
     with warnings.catch_warnings():
