@@ -19,9 +19,9 @@ class ManipulatorManeuver:
         initial_q: (alpha, beta) [rad] at t = 0, at rest.
         goal_q: (alpha, beta) [rad] to reach at rest (compared modulo 2 pi).
         max_torque: |tau| bound of the motor on alpha [N m]. Without gravity the optimal time
-            scales as max_torque^(-1/2). The value is 0.81378 (4.61066 / 4.53)^2 N m: it scales
-            a 4.61066 s local optimum at 0.81378 N m to the paper's 4.53 s. The global optimum
-            at this bound is faster: the shipped reference takes 4.256 s
+            scales as max_torque^(-1/2). The value is 0.81378 (4.61066 / 4.53)^2 = 0.84302 N m:
+            it scales a 4.61066 s local optimum at 0.81378 N m to the paper's 4.53 s. The best
+            optimum found at this bound is faster: the shipped reference takes 4.256 s
             (``optimal.load_reference("manipulator_time")``).
         angle_tolerance: success when both wrapped angle errors are within this [rad].
         velocity_tolerance: ... and both angular speeds are within this [rad/s].
@@ -53,10 +53,11 @@ class DiffDriveManeuver:
         max_wheel_torque: |tau_L|, |tau_R| bound [N m]; above the rolling traction limit of the
             default robot (about 2.2 N m per wheel), so that the optimum may slip. Not
             calibrated to the paper's 4.03 s (the paper gives no robot parameters): with the
-            default robot ``mdi-envs optimize diff_drive_time`` takes 3.16 s at 3.0 N m through
-            5-, 3- and 2-DOF modes like the paper's Fig. 8, while 4.03 s would need about 1.6 N m
-            (3.95 s at 1.66 N m), below the traction limit, where both maneuvers roll throughout
-            (2-DOF only) and the stick-slip character of the paper's maneuvers is lost.
+            default robot the shipped time-optimal reference takes 2.435 s at 3.0 N m
+            (``optimal.load_reference("diff_drive_time")``) through stick-slip modes like the
+            paper's Fig. 8; 4.03 s would need a bound below the traction limit, where both
+            maneuvers roll throughout (2-DOF only) and the stick-slip character of the paper's
+            maneuvers is lost.
         effort_final_time: maneuver A's fixed final time [s] (the paper's 4.05 s).
         position_tolerance: success when |(x, y) - goal| is within this [m] ...
         heading_tolerance: ... the wrapped heading error within this [rad] ...

@@ -6,7 +6,8 @@ with the shared measure, so that no method can report CONVERGED above its tolera
 A method may register a *direct* path (Lemke does): the same steps after the shape checks --
 NaN/inf screening, trivial cases, the method, ``natural_map`` and the status downgrade -- in one
 compiled call, so the driver's fixed cost is one dispatch instead of several Python-level passes
-over the data (7.9 -> about 3 us per call at n = 2; ``benchmarks/solvers.py`` measures it).
+over the data (about 3-4 us per call at n = 2: ``fixed_cost`` in
+``benchmarks/results/solvers.json``, written by ``python -m mdi_envs bench solvers``).
 """
 
 from __future__ import annotations
