@@ -186,8 +186,10 @@ BENCHMARKS = {  # file stem: (title, the command that writes it)
                        "python -m mdi_envs bench precision"),
     "stress": ("Stress cases", "python -m mdi_envs bench stress"),
     "startup": ("Start-up", "python -m mdi_envs bench startup"),
+    "control": ("Model-based control", "python -m mdi_envs bench control"),
     "vec_env_throughput": ("SB3 training throughput", "python -m benchmarks.vec_env_throughput"),
-    "before_after": ("Before/after speed comparison", "python -m benchmarks.before_after"),
+    "before_after": ("Before/after speed comparison",
+                     "python -m benchmarks.before_after --before DIR"),
 }
 
 
