@@ -14,6 +14,7 @@ No kernel is compiled: env classes are never imported, only their source is pars
 from __future__ import annotations
 
 import json
+import math
 import re
 import sys
 from collections.abc import Iterator
@@ -379,7 +380,7 @@ def references_page() -> None:
         lines += ["## Continuous-time optima", "",
                   "The mode sequence of a reference with its switching times and t_f optimized "
                   "against the event-driven integrator (`optimal/continuous/NAME.json`; "
-                  "[method](../guide/optimal.md)).", "",
+                  "[method](../guide/polish.md)).", "",
                   table([{"reference": c["name"], "continuous-time t_f [s]": c.get("final_time"),
                           "h-discrete optimum": c.get("discrete_cost"),
                           "intervals N": c.get("discrete_num_intervals"),
@@ -387,6 +388,10 @@ def references_page() -> None:
                           "goal error": c.get("goal_error"),
                           "integrator": (c.get("integrator") or {}).get("method")}
                          for c in continuous], floatfmt=".7g"), ""]
+    for path in sorted((ROOT / "optimal" / "continuous").glob("*_refinement.json")):
+        lines += refinement_section(load(path))
+        if path.with_suffix(".png").exists():
+            lines += [f"![{path.stem}]({copy_image(path.with_suffix('.png'), 'results')})", ""]
     for path in sorted((ROOT / "optimal" / "search").glob("*_search.json")):
         run = load(path)
         name = path.stem.removesuffix("_search")
@@ -407,6 +412,28 @@ def references_page() -> None:
         if png.exists():
             lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
     write("results/references.md", "\n".join(lines))
+
+
+def refinement_section(study: dict[str, Any]) -> list[str]:
+    """The discrete optimum per N against the continuous one (``optimal.convergence``)."""
+    optimum = study["continuous_cost"]
+    levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
+    distance = [level["cost"] - optimum for level in levels]
+    rows = [{"N": level["num_intervals"], "t_f, pattern projected [s]": level["start_cost"],
+             "t_f after the mode search [s]": level["cost"], "search rounds": level["max_rounds"],
+             "distance [s]": d, "distance / optimum": d / optimum,
+             "observed order": (math.log(d / distance[i + 1]) / math.log(
+                 levels[i + 1]["num_intervals"] / level["num_intervals"])
+                 if i + 1 < len(levels) else None),
+             "wall time [min]": level["wall_time"] / 60}
+            for i, (level, d) in enumerate(zip(levels, distance, strict=True))]
+    return [f"## Refinement toward the continuous optimum: {study['name']}", "",
+            f"`python -m optimal.convergence {study['name']} --levels N,...` writes "
+            f"`optimal/continuous/{study['name']}_refinement.json`: per N the discrete problem "
+            f"solved from the continuous optimum ({optimum:.7g} s), its brake phases projected "
+            "on the grid, then mode-searched for at most the given rounds "
+            "([method](../guide/polish.md#refinement-toward-the-continuous-optimum)).", "",
+            table(rows, floatfmt=".6g"), ""]
 
 
 def search_page() -> None:
