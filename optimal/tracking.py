@@ -18,6 +18,13 @@ it: holding a rest state would stick every contact, whose laws then repeat the r
 (a rank-deficient NLP). For the same reason the contact modes of a reference's last interval,
 which ends at rest, are its neighbour's.
 
+A brake engaged in a window that reaches past the reference's end locks its joint for good (the
+hold keeps it engaged), at the relative angle it has then: a plan that lags the reference there
+cannot make up the lag, and engaging on time locks the joint short of the goal. At such a step k
+(the reference's interval k engages a brake that interval k - 1 left released) the controller
+also solves window k - 1, the reference one step later, from the measured state and applies the
+plan of lower objective; taking it delays the rest of the episode by one step (``delays``).
+
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
 dual start) (``Opti.to_function``); a control step is one call. Its primal start is the last
@@ -133,9 +140,12 @@ class TrackingMPC(StateFeedbackPolicy):
             ``node_weight`` (``StateFeedbackPolicy``) it uses.
         compute_times: CPU time [s] of each control step of this episode.
         fallbacks: steps of this episode at which IPOPT failed and the LQR's control was applied.
-        iterations: IPOPT's iterations per step of this episode.
+        iterations: IPOPT's iterations per step of this episode (both windows' at a step that
+            solves two).
         traction: the ``FrictionEstimator`` (None: a model without friction contacts).
         friction_factors: its estimate at each step of this episode.
+        delays: steps of this episode at which the reference was taken one step later (a brake
+            engaged one step later, see the module docstring).
         index_on_less_friction: state-indexed only from the step at which the friction
             estimate is first below 1 this episode (see the module docstring); False (default):
             state-indexed whenever ``index_window`` is set.
@@ -191,6 +201,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self.fallbacks: list[int] = []
         self.iterations: list[int] = []
         self.friction_factors: list[float] = []
+        self.delays: list[int] = []
         self._previous: tuple[_Window, FloatArray, FloatArray, int] | None = None
         self._measured: tuple[FloatArray, FloatArray, FloatArray] | None = None
         self.index_on_less_friction = False
@@ -199,7 +210,7 @@ class TrackingMPC(StateFeedbackPolicy):
     def reset(self) -> None:
         """A new episode: step counter, records, warm start and friction estimate start again."""
         self.compute_times, self.fallbacks, self.iterations = [], [], []
-        self.friction_factors = []
+        self.friction_factors, self.delays = [], []
         self._previous = self._measured = None
         self._less_friction = False
         if self.traction is not None:
@@ -207,7 +218,7 @@ class TrackingMPC(StateFeedbackPolicy):
 
     def predicted_q(self, step: int) -> FloatArray:
         """(n,) the reference's q at env step ``step`` (the goal past the end)."""
-        x = self._x[min(step, len(self._keys) - 1)]
+        x = self._x[min(max(step - len(self.delays), 0), len(self._keys) - 1)]
         return x[:x.size // 2]
 
     def is_state_indexed(self) -> bool:
@@ -246,7 +257,40 @@ class TrackingMPC(StateFeedbackPolicy):
         if step >= len(self._keys):  # past the reference: the hold window, or the LQR
             if not self.has_brake:
                 return self.lqr.control(step, q, u)
-        k = min(step, len(self._keys) - 1)
+        k = min(step - len(self.delays), len(self._keys) - 1)
+        plan = self._solve(k, q, u, extra)
+        iterations = plan[-1]
+        if self._engages(k):  # the reference one step later: the brake engaged one step later
+            later = self._solve(k - 1, q, u, extra)
+            iterations += later[-1]
+            if later[0] and (not plan[0] or later[1] < plan[1]):
+                plan, k = later, k - 1
+                self.delays.append(step)
+        self.iterations.append(iterations)
+        success, _, window, x, lam, tau, _ = plan
+        brake = self._brake[k] if self._brake is not None else np.zeros(0)
+        if not success:  # the next step starts from the last solution, shifted further
+            self.fallbacks.append(step)
+            return self.lqr.control(step, q, u)[0], brake
+        self._previous = (window, x, lam, k)
+        tau0 = tau.reshape(-1, window.shapes[0][1] - 1)[:, 0]
+        return np.clip(tau0, -self.torque_bound, self.torque_bound), brake
+
+    def _engages(self, k: int) -> bool:
+        """Whether interval k engages a brake released over k - 1, in a window into the hold.
+
+        The window of k reaches the hold past the reference's end (see the module docstring).
+        """
+        engaged, steps = self._modes[0], len(self.reference.tau)
+        return engaged is not None and steps - self.horizon < k < steps and bool(
+            np.any(engaged[:, k] & ~engaged[:, k - 1]))
+
+    def _solve(self, k: int, q: FloatArray, u: FloatArray, extra: list[float]
+               ) -> tuple[bool, float, _Window, FloatArray, FloatArray, FloatArray, int]:
+        """Window k from the state (q, u).
+
+        Returns (success, objective, window, x, multipliers, tau, IPOPT's iterations).
+        """
         window = self._windows[self._keys[k]]
         reference = self._reference_points[k]
         if self._previous is None:
@@ -254,23 +298,15 @@ class TrackingMPC(StateFeedbackPolicy):
         else:
             last, x_last, lam_last, solved_at = self._previous
             x0 = np.concatenate([x_last, reference])[
-                _shift_indices(last.shapes, window.shapes, k - solved_at)]
+                _shift_indices(last.shapes, window.shapes, max(k - solved_at, 0))]
             lam0 = lam_last if last is window else self._reference_multipliers[k]
-        length = window.shapes[0][1] - 1  # intervals: q has one column per node
-        end = k + length
-        x, lam, tau = window.solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
-                                   self._terminal[end], *extra, x0, lam0)
+        end = k + window.shapes[0][1] - 1  # intervals: q has one column per node
+        x, lam, tau, objective = window.solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
+                                              self._terminal[end], *extra, x0, lam0)
         stats = window.solve.stats()
-        self.iterations.append(int(stats.get("iter_count", -1)))
-        brake = self._brake[k] if self._brake is not None else np.zeros(0)
-        success = bool(stats.get("success", False))
-        if not success:  # the next step starts from the last solution, shifted further
-            self.fallbacks.append(step)
-            return self.lqr.control(step, q, u)[0], brake
-        self._previous = (window, np.asarray(x, dtype=float).ravel(),
-                          np.asarray(lam, dtype=float).ravel(), k)
-        tau0 = np.asarray(tau, dtype=float).reshape(-1, length)[:, 0]
-        return np.clip(tau0, -self.torque_bound, self.torque_bound), brake
+        return (bool(stats.get("success", False)), float(objective), window,
+                np.asarray(x, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel(),
+                np.asarray(tau, dtype=float).ravel(), int(stats.get("iter_count", -1)))
 
     def _window(self, k: int) -> bytes:
         """The key of window k's NLP (its intervals k ... k + H - 1, as far as there are)."""
@@ -309,7 +345,8 @@ class TrackingMPC(StateFeedbackPolicy):
         opti.set_value(t.relaxation, POLISH_RELAXATION)
         friction = [t.friction_factor] if self.traction is not None else []
         solve = opti.to_function("window", [q0, u0, x_ref, tau_ref, terminal, *friction,
-                                            opti.x, opti.lam_g], [opti.x, opti.lam_g, t.tau])
+                                            opti.x, opti.lam_g],
+                                 [opti.x, opti.lam_g, t.tau, opti.f])
         return _Window(t, solve, [raw.shape for raw, _ in t._raw.values()], opti.ng)
 
     def _reference_point(self, k: int) -> FloatArray:
@@ -330,7 +367,7 @@ class TrackingMPC(StateFeedbackPolicy):
         length = window.shapes[0][1] - 1
         n, end = self.base.model.NUM_DOFS, k + length
         friction = [1.0] if self.traction is not None else []
-        _, lam, _ = window.solve(self._x[k, :n], self._x[k, n:], self._x[k:end + 1].T,
+        _, lam, _, _ = window.solve(self._x[k, :n], self._x[k, n:], self._x[k:end + 1].T,
                                  self._tau[k:end].T, self._terminal[end], *friction,
                                  self._reference_points[k], np.zeros(window.num_multipliers))
         if not window.solve.stats().get("success", False):

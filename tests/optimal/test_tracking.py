@@ -169,3 +169,24 @@ def test_the_robots_tracker_estimates_friction_from_the_torques_played() -> None
             controller.applied(played / controller.torque_bound)
         controller.control(1, step.q, step.u)
         assert controller.friction_factors[1] == pytest.approx(factor, abs=1e-6)
+
+
+def test_a_step_behind_at_the_last_engagement_it_engages_the_brake_a_step_later(
+        controller: TrackingMPC) -> None:
+    """At the reference's last released-to-engaged interval k, from the reference's state k - 1.
+
+    Engaging on time would lock the joint one interval short of the goal; the plan of window
+    k - 1 (the reference one step later) keeps the brake released, and the controller's
+    reference runs one step later from then on. From the reference's state k itself it engages
+    on time.
+    """
+    reference = controller.reference
+    engaged = reference.brake_bound[:, 0] > 0.0
+    k = int(np.flatnonzero(engaged[1:] & ~engaged[:-1])[-1]) + 1
+    controller.reset()
+    _, brake = controller.control(k, reference.q[k], reference.u[k])
+    assert controller.delays == [] and brake[0] > 0.0
+    controller.reset()
+    _, brake = controller.control(k, reference.q[k - 1], reference.u[k - 1])
+    assert controller.delays == [k] and brake[0] == 0.0
+    np.testing.assert_array_equal(controller.predicted_q(k + 1), reference.q[k])
