@@ -36,11 +36,12 @@ plan's last interval instead breaks the dynamics there, from where IPOPT converg
 minima of the window far off the reference). The first step and a step into another window
 pattern take the multipliers of that window solved from the reference's state (computed in the
 constructor): an interior-point start needs the multipliers of its nearly active inequalities,
-which zeros are not; with ``WARM_START_PUSH`` the start stays on those inequalities, the
-window from the reference's point does not converge, and the multipliers are zeros. IPOPT runs
-from a small barrier
-parameter to a loose tolerance (``SOLVER_OPTIONS``) and at most ``MAX_ITERATIONS`` iterations;
-if it fails, the LQR's control is applied (``fallbacks``) and its last iterate is dropped.
+which zeros are not. Those multipliers, and the first step, whose start is the reference's
+point, are solved with IPOPT's own warm-start pushes (the window's ``change`` function); the
+steps after the first, whose start is a shifted plan, with ``WARM_START_PUSH``'s smaller ones
+(``solve``). IPOPT runs from a small barrier parameter to a loose tolerance
+(``SOLVER_OPTIONS``) and at most ``MAX_ITERATIONS`` iterations; if it fails, the LQR's control
+is applied (``fallbacks``) and its last iterate is dropped.
 
 On a model with friction contacts (the robot) the window NLPs take a friction factor as a
 parameter (``Transcription(parametric_friction=True)``): every control step first feeds the
@@ -66,6 +67,11 @@ Speed (CPU time per control step over one 0.1-perturbed episode of each task):
   percentile, manipulator 4 / 11 instead of 15 / 23, robot (two episodes) 1 / 8 and 2 / 6
   instead of 3 / 14 and 2 / 16, the same arrival times; on the effort task, whose 40-interval
   window then takes 13 / 41 and falls back 5 times in 100 steps, IPOPT's own.
+  Steps into another window start from the stored multipliers with ``WARM_START_PUSH`` too:
+  with zero multipliers, the robot's time task from 0.01-perturbed starts took 10-23
+  iterations at each step of its stick-slip changes (steps 36-48), up to 2.1 control periods,
+  and one such step in three episodes found no plan in 50; with them the 95th percentile per
+  episode is 0.33-0.47 control periods instead of 1.04-1.57, and no step falls back.
 - The NLP functions are not compiled (CasADi JIT): their evaluations (``nlp_f``, ``nlp_g``,
   their derivatives and the Hessian) are under 10 % of a step, the rest is IPOPT and its
   linear solver.
@@ -110,6 +116,9 @@ SOLVER_OPTIONS = {"print_level": 0, "sb": "yes", "tol": 1e-4, "acceptable_tol": 
                   "acceptable_iter": 1, "mu_init": 1e-4, "warm_start_init_point": "yes"}
 """IPOPT's options besides the iteration limit (see the module docstring on speed)."""
 
+_PUSHES = tuple(f"warm_start_{name}" for name in ("bound_push", "bound_frac", "slack_bound_push",
+                                                 "slack_bound_frac", "mult_bound_push"))
+
 WARM_START_PUSH = {"manipulator_time": 1e-6, "diff_drive_time": 1e-6}
 """IPOPT's warm-start pushes into the interior (``warm_start_bound_push``, ``_bound_frac``,
 ``_slack_bound_push``, ``_slack_bound_frac``, ``_mult_bound_push``) per reference, IPOPT's own
@@ -118,10 +127,15 @@ WARM_START_PUSH = {"manipulator_time": 1e-6, "diff_drive_time": 1e-6}
 
 @dataclasses.dataclass
 class _Window:
-    """One window pattern's NLP as a function (see the module docstring)."""
+    """One window pattern's NLP as functions (see the module docstring).
+
+    ``solve`` with ``WARM_START_PUSH``'s pushes, ``change`` with IPOPT's own (``solve`` itself
+    for a reference without ``WARM_START_PUSH``).
+    """
 
     transcription: Transcription
     solve: Any
+    change: Any
     shapes: list[tuple[int, int]]
     num_multipliers: int
 
@@ -159,8 +173,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self.max_iterations = int(max_iterations)
         push = WARM_START_PUSH.get(reference.name)
         self.solver_options = {**SOLVER_OPTIONS, **({} if push is None else {
-            f"warm_start_{name}": push for name in ("bound_push", "bound_frac", "slack_bound_push",
-                                                    "slack_bound_frac", "mult_bound_push")}),
+            name: push for name in _PUSHES}),
                                **(solver_options or {}), "max_iter": self.max_iterations}
         self.lqr = TimeVaryingLQR(reference)
         self.node_states, self.node_weight = self.lqr.node_states, self.lqr.node_weight
@@ -194,9 +207,8 @@ class TrackingMPC(StateFeedbackPolicy):
         self._windows: dict[bytes, _Window] = {}
         self._keys = [self._window(k) for k in range(steps + (1 if extension else 0))]
         self._reference_points = [self._reference_point(k) for k in range(len(self._keys))]
-        self._reference_multipliers = [
-            self._reference_multiplier(k) if reference.name not in WARM_START_PUSH
-            else np.zeros(self._windows[key].num_multipliers) for k, key in enumerate(self._keys)]
+        self._reference_multipliers = [self._reference_multiplier(k)
+                                       for k in range(len(self._keys))]
         self.compute_times: list[float] = []
         self.fallbacks: list[int] = []
         self.iterations: list[int] = []
@@ -293,6 +305,7 @@ class TrackingMPC(StateFeedbackPolicy):
         """
         window = self._windows[self._keys[k]]
         reference = self._reference_points[k]
+        solve = window.change
         if self._previous is None:
             x0, lam0 = reference, self._reference_multipliers[k]
         else:
@@ -300,10 +313,11 @@ class TrackingMPC(StateFeedbackPolicy):
             x0 = np.concatenate([x_last, reference])[
                 _shift_indices(last.shapes, window.shapes, max(k - solved_at, 0))]
             lam0 = lam_last if last is window else self._reference_multipliers[k]
+            solve = window.solve
         end = k + window.shapes[0][1] - 1  # intervals: q has one column per node
-        x, lam, tau, objective = window.solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
-                                              self._terminal[end], *extra, x0, lam0)
-        stats = window.solve.stats()
+        x, lam, tau, objective = solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
+                                       self._terminal[end], *extra, x0, lam0)
+        stats = solve.stats()
         return (bool(stats.get("success", False)), float(objective), window,
                 np.asarray(x, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel(),
                 np.asarray(tau, dtype=float).ravel(), int(stats.get("iter_count", -1)))
@@ -344,10 +358,16 @@ class TrackingMPC(StateFeedbackPolicy):
         opti.set_value(t.rho, 0.0)
         opti.set_value(t.relaxation, POLISH_RELAXATION)
         friction = [t.friction_factor] if self.traction is not None else []
-        solve = opti.to_function("window", [q0, u0, x_ref, tau_ref, terminal, *friction,
-                                            opti.x, opti.lam_g],
-                                 [opti.x, opti.lam_g, t.tau, opti.f])
-        return _Window(t, solve, [raw.shape for raw, _ in t._raw.values()], opti.ng)
+        inputs = [q0, u0, x_ref, tau_ref, terminal, *friction, opti.x, opti.lam_g]
+        outputs = [opti.x, opti.lam_g, t.tau, opti.f]
+        solve = change = opti.to_function("window", inputs, outputs)
+        own = {name: value for name, value in self.solver_options.items()
+               if name not in _PUSHES}
+        if own != self.solver_options:
+            opti.solver("ipopt", {"expand": True, "print_time": False, "error_on_fail": False},
+                        own)
+            change = opti.to_function("window_change", inputs, outputs)
+        return _Window(t, solve, change, [raw.shape for raw, _ in t._raw.values()], opti.ng)
 
     def _reference_point(self, k: int) -> FloatArray:
         """The NLP point of window k on the reference (its warm start where no plan is)."""
@@ -367,10 +387,10 @@ class TrackingMPC(StateFeedbackPolicy):
         length = window.shapes[0][1] - 1
         n, end = self.base.model.NUM_DOFS, k + length
         friction = [1.0] if self.traction is not None else []
-        _, lam, _, _ = window.solve(self._x[k, :n], self._x[k, n:], self._x[k:end + 1].T,
+        _, lam, _, _ = window.change(self._x[k, :n], self._x[k, n:], self._x[k:end + 1].T,
                                  self._tau[k:end].T, self._terminal[end], *friction,
                                  self._reference_points[k], np.zeros(window.num_multipliers))
-        if not window.solve.stats().get("success", False):
+        if not window.change.stats().get("success", False):
             return np.zeros(window.num_multipliers)
         return np.asarray(lam, dtype=float).ravel()
 

@@ -33,14 +33,16 @@ def test_on_the_reference_the_plan_is_the_reference(controller: TrackingMPC) -> 
     assert controller.fallbacks == []
 
 
-def test_every_window_solved_from_the_references_state_gives_its_multipliers() -> None:
+@pytest.mark.parametrize("name", ["diff_drive_effort", "diff_drive_time"])
+def test_every_window_solved_from_the_references_state_gives_its_multipliers(name: str) -> None:
     """The stored multipliers (the start of a first or window-changing step) are a solution's.
 
-    On the robot's effort reference (IPOPT's own warm-start pushes). A failed solve would leave
-    zeros; each window has at least one nearly active inequality (a torque bound or a contact
-    law), whose multiplier is not zero.
+    On both robot references (the time task's with ``WARM_START_PUSH``: the stored multipliers
+    are solved with IPOPT's own pushes). A failed solve would leave zeros; each window has at
+    least one nearly active inequality (a torque bound or a contact law), whose multiplier is
+    not zero.
     """
-    controller = TrackingMPC(load_reference("diff_drive_effort"), horizon=3)
+    controller = TrackingMPC(load_reference(name), horizon=3)
     for key, multipliers in zip(controller._keys, controller._reference_multipliers,
                                 strict=True):
         assert multipliers.shape == (controller._windows[key].num_multipliers,)
