@@ -119,6 +119,9 @@ SOLVER_OPTIONS = {"print_level": 0, "sb": "yes", "tol": 1e-4, "acceptable_tol": 
 _PUSHES = tuple(f"warm_start_{name}" for name in ("bound_push", "bound_frac", "slack_bound_push",
                                                  "slack_bound_frac", "mult_bound_push"))
 
+_PLUGIN_OPTIONS = {"expand": True, "print_time": False, "error_on_fail": False}
+"""CasADi's options of the IPOPT plugin (an SX expansion; a failed solve is a status)."""
+
 WARM_START_PUSH = {"manipulator_time": 1e-6, "diff_drive_time": 1e-6}
 """IPOPT's warm-start pushes into the interior (``warm_start_bound_push``, ``_bound_frac``,
 ``_slack_bound_push``, ``_slack_bound_frac``, ``_mult_bound_push``) per reference, IPOPT's own
@@ -138,6 +141,23 @@ class _Window:
     change: Any
     shapes: list[tuple[int, int]]
     num_multipliers: int
+
+
+@dataclasses.dataclass
+class _Plan:
+    """One window's solve from the measured state.
+
+    x and multipliers: the NLP's point (flat); tau (m * H,): the window's torques [N m],
+    column-major; objective: the NLP's; iterations: IPOPT's.
+    """
+
+    success: bool
+    objective: float
+    window: _Window
+    x: FloatArray
+    multipliers: FloatArray
+    tau: FloatArray
+    iterations: int
 
 
 class TrackingMPC(StateFeedbackPolicy):
@@ -271,21 +291,20 @@ class TrackingMPC(StateFeedbackPolicy):
                 return self.lqr.control(step, q, u)
         k = min(step - len(self.delays), len(self._keys) - 1)
         plan = self._solve(k, q, u, extra)
-        iterations = plan[-1]
+        iterations = plan.iterations
         if self._engages(k):  # the reference one step later: the brake engaged one step later
             later = self._solve(k - 1, q, u, extra)
-            iterations += later[-1]
-            if later[0] and (not plan[0] or later[1] < plan[1]):
+            iterations += later.iterations
+            if later.success and (not plan.success or later.objective < plan.objective):
                 plan, k = later, k - 1
                 self.delays.append(step)
         self.iterations.append(iterations)
-        success, _, window, x, lam, tau, _ = plan
         brake = self._brake[k] if self._brake is not None else np.zeros(0)
-        if not success:  # the next step starts from the last solution, shifted further
+        if not plan.success:  # the next step starts from the last solution, shifted further
             self.fallbacks.append(step)
             return self.lqr.control(step, q, u)[0], brake
-        self._previous = (window, x, lam, k)
-        tau0 = tau.reshape(-1, window.shapes[0][1] - 1)[:, 0]
+        self._previous = (plan.window, plan.x, plan.multipliers, k)
+        tau0 = plan.tau.reshape(-1, plan.window.shapes[0][1] - 1)[:, 0]
         return np.clip(tau0, -self.torque_bound, self.torque_bound), brake
 
     def _engages(self, k: int) -> bool:
@@ -298,11 +317,8 @@ class TrackingMPC(StateFeedbackPolicy):
             np.any(engaged[:, k] & ~engaged[:, k - 1]))
 
     def _solve(self, k: int, q: FloatArray, u: FloatArray, extra: list[float]
-               ) -> tuple[bool, float, _Window, FloatArray, FloatArray, FloatArray, int]:
-        """Window k from the state (q, u).
-
-        Returns (success, objective, window, x, multipliers, tau, IPOPT's iterations).
-        """
+               ) -> _Plan:
+        """Window k from the state (q, u)."""
         window = self._windows[self._keys[k]]
         reference = self._reference_points[k]
         solve = window.change
@@ -318,9 +334,9 @@ class TrackingMPC(StateFeedbackPolicy):
         x, lam, tau, objective = solve(q, u, self._x[k:end + 1].T, self._tau[k:end].T,
                                        self._terminal[end], *extra, x0, lam0)
         stats = solve.stats()
-        return (bool(stats.get("success", False)), float(objective), window,
-                np.asarray(x, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel(),
-                np.asarray(tau, dtype=float).ravel(), int(stats.get("iter_count", -1)))
+        return _Plan(bool(stats.get("success", False)), float(objective), window,
+                     np.asarray(x, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel(),
+                     np.asarray(tau, dtype=float).ravel(), int(stats.get("iter_count", -1)))
 
     def _window(self, k: int) -> bytes:
         """The key of window k's NLP (its intervals k ... k + H - 1, as far as there are)."""
@@ -352,7 +368,7 @@ class TrackingMPC(StateFeedbackPolicy):
         tracking += casadi.bilin(terminal, error[:, big_h], error[:, big_h])
         effort_unit = problem.torque_bound**2 * problem.final_time
         opti.minimize(opti.f - t.cost / effort_unit + tracking / big_h)
-        opti.solver("ipopt", {"expand": True, "print_time": False, "error_on_fail": False},
+        opti.solver("ipopt", _PLUGIN_OPTIONS,
                     self.solver_options)
         q0, u0 = t._start
         opti.set_value(t.rho, 0.0)
@@ -364,7 +380,7 @@ class TrackingMPC(StateFeedbackPolicy):
         own = {name: value for name, value in self.solver_options.items()
                if name not in _PUSHES}
         if own != self.solver_options:
-            opti.solver("ipopt", {"expand": True, "print_time": False, "error_on_fail": False},
+            opti.solver("ipopt", _PLUGIN_OPTIONS,
                         own)
             change = opti.to_function("window_change", inputs, outputs)
         return _Window(t, solve, change, [raw.shape for raw, _ in t._raw.values()], opti.ng)
