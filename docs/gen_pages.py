@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -61,18 +60,9 @@ def copy_image(source: Path, folder: str) -> str:
     return f"img/{source.name}"
 
 
-ISSUE_NOTE = re.compile(r"\s*\([^()]*\bissue\b[^()]*\)")
-"""A parenthesis naming a project issue in a result's note: history, not a result."""
-
-
-def clean(text: str) -> str:
-    """``text`` without parentheses naming issues."""
-    return ISSUE_NOTE.sub("", text)
-
-
 def table(rows: list[dict[str, Any]], floatfmt: str = ".4g") -> str:
-    """A Markdown table of records (pandas ``to_markdown``), cleaned."""
-    return clean(pd.DataFrame(rows).to_markdown(index=False, floatfmt=floatfmt))
+    """A Markdown table of records (pandas ``to_markdown``)."""
+    return pd.DataFrame(rows).to_markdown(index=False, floatfmt=floatfmt)
 
 
 # --- environments -----------------------------------------------------------------------------
@@ -234,8 +224,8 @@ def benchmark_page() -> None:
         lines += ["## Headline", "", "Every target of the suite, per benchmark "
                   "(`benchmarks/results/headline.json`, `benchmarks.report.targets_table`).", ""]
         for name in dict.fromkeys(r["benchmark"] for r in rows):
-            lines += [f"**{name}**", "", clean(targets_table(
-                [{**r, "benchmark": None} for r in rows if r["benchmark"] == name])), ""]
+            lines += [f"**{name}**", "", targets_table(
+                [{**r, "benchmark": None} for r in rows if r["benchmark"] == name]), ""]
     for stem, (title, command) in BENCHMARKS.items():
         path = folder / f"{stem}.json"
         if not path.exists():
@@ -245,7 +235,7 @@ def benchmark_page() -> None:
                   + machine_text(run), ""]
         targets = None
         if run.get("targets"):
-            lines += [clean(targets_table(run["targets"])), ""]
+            lines += [targets_table(run["targets"]), ""]
         if stem == "solvers":
             lines += solver_tables(run)
         if stem == "stress":
