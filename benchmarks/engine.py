@@ -335,7 +335,7 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
 
 
 def run(config: EngineConfig, output: Path, quick: bool) -> str:
-    """Run the whole benchmark, write the outputs and return the Markdown report."""
+    """Run the whole benchmark, write the outputs and return its summary (Markdown)."""
     settings = {"quick": quick, "time_step": TIME_STEP,
                 **{k: v for k, v in asdict(config).items() if k != "shortcut_cases"}}
     packages = (*timing.VERSIONED_PACKAGES, "mujoco")
@@ -370,7 +370,7 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
         plot_single_step(record["single_step"], record["per_scene"],
                          output / "engine_single_step.png")
         plot_shortcuts(record["shortcuts"], output / "engine_shortcuts.png")
-    return markdown_report(record)
+    return summary(record, ("numpy", "numba", "mujoco"))
 
 
 def shortcuts_text(shortcuts: Any) -> str:
@@ -385,29 +385,6 @@ def case_record(case: Any) -> dict[str, Any]:
     return {"label": case.label, "model": case.model.__name__,
             "mix": [s.name for s in case.mix_scenes],
             "scenes": report.json_safe([asdict(s) for s in case.scenes])}
-
-
-def markdown_report(record: Mapping[str, Any]) -> str:
-    """The targets and the result tables of one run (printed on stdout)."""
-    per_copy = ["model", "scene", "copies", "substeps", "per_copy_step_s"]
-    return summary(record, ("numpy", "numba", "mujoco"), {
-        "Compile time [s] (first calls, excluded from every timing)": record["compile"],
-        "One step from Python [s] (median)": (record["single_step"],
-                                              ["model", "scene", "entry", "median_s", "q1_s",
-                                               "q3_s"]),
-        "In-kernel step per scene [s]": (record["per_scene"], per_copy),
-        "Batched: s per copy-step of step_batch, each model's scene mix": (record["batched"],
-                                                                          per_copy),
-        "Substeps per call [s per copy-step]": (record["substeps"], per_copy),
-        "Shortcuts on vs off [s per copy-step]": (record["shortcuts"], [
-            "shortcut", "model", "scene", "off_scene", "on.per_copy_step_s",
-            "off.per_copy_step_s", "speedup", "speedup_fastest_rounds",
-            "max_state_difference"]),
-        "Brake stop (steps until the relative velocity < 1 % of 1 rad/s)": (
-            [{"simulator": key, **value} for key, value in record["brake_stop"].items()],
-            ["simulator", "steps", "relative_angle_at_stop", "solref",
-             "relative_speed_after_first_step"]),
-    })
 
 
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],

@@ -311,7 +311,7 @@ def _pin(cpu: int | None) -> tuple[set[int] | None, dict[str, Any]]:
 
 
 def run(config: EnvsConfig, output: Path, quick: bool, log: Log | None = None) -> str:
-    """Run the whole benchmark, write the outputs and return the Markdown report."""
+    """Run the whole benchmark, write the outputs and return its summary (Markdown)."""
     env_ids = tuple(config.env_ids if config.env_ids is not None else mdi_envs.ENV_IDS)
     settings = {"quick": quick, "env_ids": env_ids,
                 **{k: v for k, v in asdict(config).items() if k != "env_ids"}}
@@ -339,24 +339,12 @@ def run(config: EnvsConfig, output: Path, quick: bool, log: Log | None = None) -
     finally:
         if previous is not None:
             os.sched_setaffinity(0, previous)
-    return markdown_report(record)
+    return summary(record, ("numpy", "numba", "gymnasium", "mujoco"))
 
 
 def short_name(env_id: str) -> str:
     """A short label: ``mdi_envs/BlockableManipulator-v0`` -> ``BlockableManipulator``."""
     return env_id.split("/")[-1].removesuffix("-v0") if env_id.startswith("mdi_envs/") else env_id
-
-
-def markdown_report(record: Mapping[str, Any]) -> str:
-    """The targets and the result tables of one run (printed on stdout)."""
-    return summary(record, ("numpy", "numba", "gymnasium", "mujoco"), {
-        "One env, env.step [µs] (gym.make and unwrapped; pre-sampled actions)": (
-            record["single_env"] + record["unavailable"],
-            ["env_id", "gym.make.median_us", "gym.make.min_us", "unwrapped.median_us",
-             "frame_skip", "per_physics_step_us", "first_step_s", "error"]),
-        "Vector env throughput": (record["vector_env"], [
-            "env_id", "mode", "num_envs", "env_steps_per_s", "physics_steps_per_s"]),
-    })
 
 
 def plot_step(single: Sequence[dict[str, Any]], unavailable: Sequence[dict[str, Any]],

@@ -76,16 +76,7 @@ def run(output: Path, quick: bool) -> str:
                                             for m in METHODS}})
         if rows:  # without peer data nothing is drawn (a log axis of no values fails)
             plot(rows, output / "fc3d.png")
-    return markdown(record)
-
-
-def markdown(record: dict[str, Any]) -> str:
-    """The run line, per problem each method's time, residual and status, and the counts."""
-    return report.summary(record, ("numpy", "numba", "scipy"), {
-        f"FC3D per problem, tol {TOL:g}": (record["problems"], ["name", "n", *(
-            f"{m}.{k}" for m in METHODS for k in ("time_s", "residual", "status"))]),
-        "Problems converged": [{**record["solved_by_method"], "any": record["solved_by_any"],
-                                "of": len(record["problems"])}]})
+    return report.summary(record, ("numpy", "numba", "scipy"))
 
 
 def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:

@@ -37,12 +37,6 @@ def format_number(value: float | None) -> str:
     return f"{value:.3g}" if 1e-2 <= abs(value) < 1e4 else f"{value:.2e}"
 
 
-def markdown_table(rows: Iterable[Any], columns: Sequence[str] | None = None) -> str:
-    """A GitHub Markdown table (pandas ``DataFrame.to_markdown``); cells are written as given."""
-    frame = pd.DataFrame(list(rows), columns=list(columns) if columns is not None else None)
-    return frame.to_markdown(index=False, disable_numparse=True)
-
-
 def flat_table(rows: Iterable[Mapping[str, Any]], columns: Sequence[str] | None = None) -> str:
     """Markdown of records: nested dicts become ``a.b`` columns, list fields are left out."""
     frame = pd.json_normalize(list(rows))
@@ -52,15 +46,16 @@ def flat_table(rows: Iterable[Mapping[str, Any]], columns: Sequence[str] | None 
 
 
 def summary(record: Mapping[str, Any], packages: Sequence[str],
-            sections: Mapping[str, Any]) -> str:
+            sections: Mapping[str, Any] | None = None) -> str:
     """A run's stdout report: run line, notes, targets, then per title a table of records.
 
-    A section is records (``flat_table``), a (records, columns) pair, or ready text.
+    The full results are in the run's JSON (rendered by the docs' results page). A section is
+    records (``flat_table``), a (records, columns) pair, or ready text.
     """
     lines = [run_line(record, packages), *(f"* {note}" for note in record.get("notes") or [])]
     if record.get("targets"):
         lines += ["", "**Targets**", "", targets_table(record["targets"])]
-    for title, section in sections.items():
+    for title, section in (sections or {}).items():
         rows, columns = section if isinstance(section, tuple) else (section, None)
         if rows:
             text = rows if isinstance(rows, str) else flat_table(rows, columns)
@@ -146,13 +141,13 @@ def targets_table(targets: Sequence[Mapping[str, Any]]) -> str:
         unit = t["unit"] if t["unit"] in ("×", "") else f" {t['unit']}"
         return f"{t['comparison']} {t['threshold']:g}{unit}"
 
-    return markdown_table([{
+    return pd.DataFrame([{
         **({"benchmark": t["benchmark"]} if t.get("benchmark") else {}),
         "target": t["target"], "threshold": threshold(t),
         "measured": target_value(t["measured"], t["unit"]),
         "met": {True: "✓", False: "✗"}.get(t["met"], "–" if t["measured"] is not None
                                             else "not measured"),
-        "note": t["note"]} for t in targets])  # fmt: skip
+        "note": t["note"]} for t in targets]).to_markdown(index=False, disable_numparse=True)
 
 
 def run_line(record: Mapping[str, Any], packages: Sequence[str]) -> str:

@@ -137,7 +137,7 @@ def compare_lemke(problems: Sequence[E.Problem], plan: TimingPlan, log: Log
 
 
 def run(config: BenchConfig, output: Path, quick: bool) -> str:
-    """Run the whole benchmark, write the outputs and return the Markdown report."""
+    """Run the whole benchmark, write the outputs and return its summary (Markdown)."""
     with report.study("solvers", output, {"quick": quick, **asdict(config)}) as (record, log, _):
         record["first_call"] = measure_first_calls(config, log)
         warm_up([E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)])
@@ -153,7 +153,7 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
         plot_by_entry(aggregates, output / "solvers_time_vs_size.png", "time_median_s")
         plot_by_entry(aggregates, output / "solvers_residual_vs_size.png", "residual_max")
         plot_ratios(rows, output / "lemke_vs_quantecon.png")
-    return markdown_report(record)
+    return summary(record, ("numpy", "numba", "quantecon"))
 
 
 def aggregate_size_study(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -181,31 +181,6 @@ def ratio_summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
              "median_ratio_driver": float(np.median([r["ratio_driver"] for r in members])),
              "median_ratio_kernel": float(np.median([r["ratio_kernel"] for r in members]))}
             for name, members in sets.items() if members]
-
-
-def markdown_report(record: dict[str, Any]) -> str:
-    """The result tables of one run (printed on stdout)."""
-    first = record["first_call"]
-    comparison = record["quantecon_comparison"]
-    return summary(record, ("numpy", "numba", "quantecon"), {
-        "First call per entry [s] (fresh interpreter)": [
-            {"probe": probe, **result.get("first_call_s", result)}
-            for probe, result in first.items()],
-        "Work vs size (median over instances; our methods through solve_lcp)": (
-            record["size_study"]["aggregates"], ["family", "n", "entry", "time_median_s",
-                                                 "iterations_median", "residual_max", "solved",
-                                                 "instances"]),
-        "Lemke vs QuantEcon per problem (median time per solve [s])": (comparison["problems"], [
-            "name", "n", "driver.time.median_s", "kernel.time.median_s",
-            "quantecon.time.median_s", "ratio_driver", "ratio_kernel",
-            "kernel.outcome.residual", "quantecon.outcome.residual",
-            "kernel.outcome.iterations", "quantecon.outcome.iterations",
-            "kernel.outcome.status", "quantecon.outcome.status"]),
-        "Median time ratio ours / QuantEcon (< 1: ours faster)": comparison["median_ratios"],
-        "Fixed cost per call at n = 2 [s]": (record["fixed_cost"], [
-            "name", "driver.time.median_s", "kernel.time.median_s",
-            "quantecon.time.median_s"]),
-    })
 
 
 def plot_by_entry(aggregates: Sequence[dict[str, Any]], path: Path, value: str) -> None:

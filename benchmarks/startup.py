@@ -68,7 +68,7 @@ def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
 
 def run(quick: bool, output: Path, python_path: Path | None = None,
         repeats: int = 5) -> str:
-    """Run the study, write ``startup.json`` / ``startup.png``, return the Markdown table."""
+    """Run the study, write ``startup.json`` / ``startup.png``, return the targets (Markdown)."""
     from mdi_envs import ENV_IDS
 
     log = Progress()
@@ -107,7 +107,7 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
     output.mkdir(parents=True, exist_ok=True)
     (output / "startup.json").write_text(json.dumps(record, indent=2))
     _plot(record, ids, entries, output / "startup.png")
-    return table(record)
+    return report.targets_table(record["targets"]) if record["targets"] else "no targets (quick)"
 
 
 def _ratios(warm: dict[str, Any], entries: Sequence[str]) -> dict[str, float]:
@@ -137,17 +137,6 @@ def _targets(record: dict[str, Any], env_ids: Sequence[str],
             f"{os.cpu_count()} cores",
             seconds <= 30.0 and record["compile_all"]["returncode"] == 0))
     return targets
-
-
-def table(record: dict[str, Any]) -> str:
-    """Markdown of a ``startup.json`` record: compile all, then per case warm, ratio and cold."""
-    rows = [{"case": key, "warm median [s]": warm.get("median"), "warm min [s]": warm.get("min"),
-             "/ Acrobot-v1": record["ratios_to_acrobot"].get(key),
-             "cold [s]": record["cold"].get(key, {}).get("median"),
-             "error": (warm.get("errors") or [""])[0]} for key, warm in record["warm"].items()]
-    compiled = record["compile_all"]
-    return (f"`mdi-envs compile all`: {compiled['seconds']:.1f} s (exit {compiled['returncode']},"
-            f" {'user' if record['quick'] else 'empty'} cache)\n\n" + report.flat_table(rows))
 
 
 def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],

@@ -73,43 +73,15 @@ def margin(criterion: Mapping[str, Any]) -> float:
     return float(np.clip(value / limit, MARGIN_FLOOR, MARGIN_CEILING))
 
 
-def _number(value: Any) -> str:
-    """A value or limit: integers as such, others with three significant digits."""
-    value = float(value)
-    if math.isfinite(value) and value == int(value) and abs(value) < 1e6:
-        return str(int(value))
-    return f"{value:.3g}" if math.isfinite(value) else str(value)
-
-
-def _text(value: Any, digits: int) -> str:
-    """A parameter: floats with ``digits`` significant digits, lists comma-separated at 3."""
-    if isinstance(value, (list, tuple)):
-        return ",".join(_text(v, 3) for v in value)
-    return f"{value:.{digits}g}" if isinstance(value, float) else str(value)
-
-
-def _criterion(name: str, c: Mapping[str, Any]) -> str:
-    """``name value <= limit``, in bold with FAIL when it failed."""
-    part = f"{name} {_number(c['value'])} {c['relation']} {_number(c['limit'])}"
-    return part if c["passed"] else f"**{part} FAIL**"
-
-
-def markdown_report(record: Mapping[str, Any]) -> str:
-    """A summary line, then one row per case (parameters, criteria, PASS/FAIL), then the notes."""
+def verdict(record: Mapping[str, Any]) -> str:
+    """One line: cases passed of all, the failing ones named, the run time, then the notes."""
     cases = record["cases"]
     failed = [c["name"] for c in cases if not c["passed"]]
     mode = "quick" if (record.get("config") or {}).get("quick") else "full"
-    rows = [{"case": c["name"],
-             "parameters": ", ".join(f"{k}={_text(v, 4)}" for k, v in c["parameters"].items()),
-             "criteria (value relation limit)": "; ".join(
-                 _criterion(name, criterion) for name, criterion in c["criteria"].items()),
-             "result": "PASS" if c["passed"] else "**FAIL**"} for c in cases]
-    lines = [f"Stress test ({mode}): {len(cases) - len(failed)} of {len(cases)} cases pass"
-             + (f"; failing: {', '.join(failed)}" if failed else "")
-             + f". Run time {record['run_time_s']:.0f} s.", "", report.markdown_table(rows)]
-    if record.get("notes"):
-        lines += ["", "Notes:", *[f"* {note}" for note in record["notes"]]]
-    return "\n".join(lines)
+    return "\n".join([f"Stress test ({mode}): {len(cases) - len(failed)} of {len(cases)} cases "
+                      "pass" + (f"; failing: {', '.join(failed)}" if failed else "")
+                      + f". Run time {record['run_time_s']:.0f} s.",
+                      *(f"* {note}" for note in record.get("notes") or [])])
 
 
 def plot_margins(cases: Sequence[Mapping[str, Any]], path: Path) -> None:
@@ -140,7 +112,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns 1 if any case fails, else 0."""
     args = arguments(__doc__, argv)
     record = run(args.output, args.quick)
-    print(markdown_report(record))
+    print(verdict(record))
     return 0 if record["passed"] else 1
 
 

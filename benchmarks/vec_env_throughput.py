@@ -83,12 +83,6 @@ def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str
             "update_s": train_s - timer.rollout_s}  # fmt: skip
 
 
-def markdown(results: Sequence[dict[str, Any]]) -> str:
-    """One row per vector env: set-up, training and rollout steps per second, update time."""
-    return report.flat_table(results, ["backend", "setup_s", "train_steps_per_s",
-                                       "rollout_steps_per_s", "update_s"])
-
-
 def plot(record: dict[str, Any], path: Path) -> None:
     """Bars: training and rollout steps per second per vector env."""
     results = record["results"]
@@ -122,7 +116,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args.output.mkdir(parents=True, exist_ok=True)
     (args.output / "vec_env_throughput.json").write_text(json.dumps(record, indent=1) + "\n")
     plot(record, args.output / "vec_env_throughput.png")
-    print(markdown(record["results"]))
+    print(report.flat_table(record["results"], ["backend", "setup_s", "train_steps_per_s",
+                                                "rollout_steps_per_s", "update_s"]))
     return 0
 
 

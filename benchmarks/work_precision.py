@@ -153,11 +153,6 @@ class Context:
             self._compiled.add(key)
         return st
 
-    def copies(self, model: Any, parameters: Any, dt: float, method: str = "enumerative"
-               ) -> Copies:
-        """One copy at rest at the origin, of ``stepper(model, parameters, dt, method)``."""
-        return Copies(self.stepper(model, parameters, dt, method))
-
 
 class Copies:
     """N copies of one stepper's state with preallocated ``step_batch`` arguments."""
@@ -241,26 +236,23 @@ def ball_horizon(p: BouncingBallParameters, gaps: np.ndarray) -> float:
     return 1.25 * float(ball_closed_form(p, float(gaps.max()))[1][-1])
 
 
-def _ball_drop_errors(p: BouncingBallParameters, gap: float, apexes: np.ndarray,
-                      landings: np.ndarray) -> tuple[np.ndarray, float]:
-    """(relative apex errors (BOUNCES,), largest |landing time error| [s]) of one drop."""
-    exact_apex, exact_impacts = ball_closed_form(p, gap)
-    relative = np.abs(apexes - exact_apex) / exact_apex
-    return relative, float(np.abs(landings - exact_impacts[1:]).max())
-
-
-def _ball_summary(per_drop: list[tuple[np.ndarray, float] | str]) -> dict[str, Any]:
-    """Aggregate per-drop errors (or why a drop has none) into the point's errors."""
-    done = [d for d in per_drop if not isinstance(d, str)]
-    if len(done) < len(per_drop):
-        reasons = sorted({d for d in per_drop if isinstance(d, str)})
-        return {"error": math.nan, "failed_drops": len(per_drop) - len(done),
-                "status": f"failed: {len(per_drop) - len(done)} of {len(per_drop)} drops: "
-                          + "; ".join(reasons)}
-    worst = np.array([d[0].max() for d in done])
+def _ball_summary(p: BouncingBallParameters, gaps: np.ndarray,
+                  per_drop: list[tuple[np.ndarray, np.ndarray] | str]) -> dict[str, Any]:
+    """A point's errors from each drop's (apex gaps [m], landing times [s]) or why it has none."""
+    reasons = sorted({d for d in per_drop if isinstance(d, str)})
+    if reasons:
+        failed = sum(isinstance(d, str) for d in per_drop)
+        return {"error": math.nan, "failed_drops": failed,
+                "status": f"failed: {failed} of {len(per_drop)} drops: " + "; ".join(reasons)}
+    exact = [ball_closed_form(p, float(gap)) for gap in gaps]
+    relative = np.array([np.abs(apexes - apex) / apex  # (D, BOUNCES)
+                         for (apexes, _), (apex, _) in zip(per_drop, exact, strict=True)])
+    landing = [np.abs(landings - impacts[1:]).max()
+               for (_, landings), (_, impacts) in zip(per_drop, exact, strict=True)]
+    worst = relative.max(axis=1)
     return {"error": float(worst.mean()), "error_max": float(worst.max()),
-            "apex_error_by_bounce": [float(x) for x in np.mean([d[0] for d in done], axis=0)],
-            "impact_time_error_s": float(np.mean([d[1] for d in done])), "failed_drops": 0}
+            "apex_error_by_bounce": [float(x) for x in relative.mean(axis=0)],
+            "impact_time_error_s": float(np.mean(landing)), "failed_drops": 0}
 
 
 def ball_errors(p: BouncingBallParameters, gaps: np.ndarray, y: np.ndarray, v: np.ndarray,
@@ -271,9 +263,9 @@ def ball_errors(p: BouncingBallParameters, gaps: np.ndarray, y: np.ndarray, v: n
     largest sample at a + to - sign change of y'); ``impact_time_error_s`` from the landing times
     of the simulated flights; ``error_max``, ``apex_error_by_bounce``, ``failed_drops``.
     """
-    per_drop: list[tuple[np.ndarray, float] | str] = []
+    per_drop: list[tuple[np.ndarray, np.ndarray] | str] = []
     g, r = p.gravity, p.radius
-    for i, gap in enumerate(gaps):
+    for i in range(len(gaps)):
         if not (np.isfinite(y[i]).all() and np.isfinite(v[i]).all()):
             per_drop.append("the simulation diverged (NaN)")
             continue
@@ -284,22 +276,22 @@ def ball_errors(p: BouncingBallParameters, gaps: np.ndarray, y: np.ndarray, v: n
         j = turns[:BOUNCES] + (y[i, turns[:BOUNCES] + 1] > y[i, turns[:BOUNCES]])
         gap_j, v_j = y[i, j] - r, v[i, j]
         landings = j * dt + (v_j + np.sqrt(v_j**2 + 2.0 * g * np.maximum(gap_j, 0.0))) / g
-        per_drop.append(_ball_drop_errors(p, float(gap), gap_j, landings))
-    return _ball_summary(per_drop)
+        per_drop.append((gap_j, landings))
+    return _ball_summary(p, gaps, per_drop)
 
 
 def ball_event_errors(p: BouncingBallParameters, gaps: np.ndarray, runs: list[Trajectory]
                       ) -> dict[str, Any]:
     """``ball_errors`` from event-driven runs: apex events' gaps and impact events' times."""
-    per_drop: list[tuple[np.ndarray, float] | str] = []
-    for gap, run in zip(gaps, runs, strict=True):
+    per_drop: list[tuple[np.ndarray, np.ndarray] | str] = []
+    for run in runs:
         apexes = [e.q[1] - p.radius for e in run.events_of(EVENT_APEX)][:BOUNCES]
         impacts = [e.t for e in run.events_of(EVENT_IMPACT)][1:BOUNCES + 1]
         if len(apexes) < BOUNCES or len(impacts) < BOUNCES:
             per_drop.append(f"fewer than {BOUNCES} apex events (run {run.status})")
             continue
-        per_drop.append(_ball_drop_errors(p, float(gap), np.array(apexes), np.array(impacts)))
-    return _ball_summary(per_drop)
+        per_drop.append((np.array(apexes), np.array(impacts)))
+    return _ball_summary(p, gaps, per_drop)
 
 
 def _ball_setup(ctx: Context) -> tuple[BouncingBallParameters, np.ndarray, float]:
@@ -417,7 +409,7 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
         a = max(p.gravity * (math.sin(p.slope_angle)
                              - p.friction_coefficient * math.cos(p.slope_angle)), 0.0)
         num_steps = _steps(1.0, dt)
-        run = ctx.copies(models.SlidingBlock, p, dt, method)
+        run = Copies(ctx.stepper(models.SlidingBlock, p, dt, method))
         wall, repeats, final = ctx.timed(partial(run.run, [(num_steps, (0.0,), ())]))
         exact = np.array([0.5 * a, 0.0, a, 0.0])  # (s, n, s', n') at T = 1 s
         errors = {"error": float(np.abs(final - exact).max())}
@@ -427,7 +419,7 @@ def _slope_point(ctx: Context, method: str, case: str, dt: float) -> dict[str, A
         p.slope_angle, p.friction_coefficient, p.mass, STICK_SLIP["rate"], p.gravity)
     num_steps = round((t_s + 0.5) / dt)
     pushes = np.array([push((k + 0.5) * dt) for k in range(num_steps)])
-    run = ctx.copies(models.SlidingBlock, p, dt, method)
+    run = Copies(ctx.stepper(models.SlidingBlock, p, dt, method))
     speeds = np.empty(num_steps)
 
     def per_step() -> np.ndarray:
@@ -491,7 +483,7 @@ def manipulator_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
     """Moreau-Jean points: one ``step_batch`` call per phase (timed), replayed per sample."""
     for dt in ctx.config.manipulator_time_steps:
         phases = manipulator_phases(dt)
-        run = ctx.copies(models.BlockableManipulator, None, dt)
+        run = Copies(ctx.stepper(models.BlockableManipulator, None, dt))
         stride = _steps(SAMPLE_INTERVAL, dt)
         wall, repeats, final = ctx.timed(partial(
             run.run, [(steps, [torque], [bound]) for steps, torque, bound in phases]))
@@ -541,7 +533,7 @@ def manipulator_mujoco(ctx: Context) -> Iterator[dict[str, Any]]:
 
 def diff_drive_run(ctx: Context, dt: float) -> tuple[Callable[[], np.ndarray], Copies]:
     """A zero-argument run of the robot's phases at dt (one call per phase), and its copies."""
-    run = ctx.copies(models.DiffDriveRobot, None, dt)
+    run = Copies(ctx.stepper(models.DiffDriveRobot, None, dt))
     return partial(run.run, [(_steps(duration, dt), tau, ())
                              for duration, tau in DIFF_DRIVE_PHASES]), run
 
@@ -739,24 +731,6 @@ def equal_time_comparison(ours: Sequence[Mapping[str, Any]],
     return result
 
 
-def markdown_report(record: Mapping[str, Any]) -> str:
-    """The targets, the equal-time comparison, the compile times and one table per scene."""
-    comparison = record.get("equal_time") or {}
-    columns = ["series", "parameter", "value", "wall_time_s", "error", "error_max",
-               "final_error", "speed_error", "impact_time_error_s", "status"]
-    return summary(record, ("numpy", "numba", "scipy", "mujoco"), {
-        "Ball: MuJoCo's error / ours at equal wall time (MuJoCo's Pareto front interpolated "
-        f"in log-log; clamped: a lower bound). {comparison.get('summary', '')}":
-            comparison.get("rows"),
-        "Compile time [s] (first step_batch per kernel, excluded from every wall time)":
-            record["compile"],
-        **{title: ([p for p in record["points"] if p["scene"] == scene], columns)
-           for scene, title in SCENE_TITLES.items()},
-        "References": [{"scene": k, **v} for k, v in record["references"].items()],
-        "MuJoCo ball calibration": record.get("mujoco_ball_calibration"),
-    })
-
-
 def plot_scene(points: Sequence[Mapping[str, Any]], scene: str, path: Path) -> None:
     """Log-log error against wall time, one line per series, each point labelled by dt/rtol."""
     fig, ax = plt.subplots(figsize=(8.0, 5.4))
@@ -817,7 +791,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point."""
     args = timing.arguments(__doc__, argv)
     record = run(args.output, args.quick)
-    print(markdown_report(record))
+    print(summary(record, ("numpy", "numba", "scipy", "mujoco")))
     return 1 if record.get("failed_sections") else 0
 
 

@@ -239,7 +239,10 @@ def benchmark_page() -> None:
         if stem == "solvers":
             lines += solver_tables(run)
         if stem == "stress":
-            targets = [{"family": c["family"], "case": c["name"], "passed": c["passed"]}
+            targets = [{"family": c["family"], "case": c["name"], "passed": c["passed"],
+                        "criteria (value relation limit)": "; ".join(
+                            f"{name} {float(k['value']):.3g} {k['relation']} "
+                            f"{float(k['limit']):.3g}" for name, k in c["criteria"].items())}
                        for c in run["cases"]]
         elif stem == "fc3d":
             targets = [{"problem": p["name"], "n": p["n"], "contacts": p["contacts"],

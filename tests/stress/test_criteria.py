@@ -116,11 +116,11 @@ def test_report_of_a_failing_case(tmp_path: Path) -> None:
              {"family": "lcp", "name": "lcp bad", "parameters": {"dt": [1e-3, 2e-3]},
               "metrics": {}, "criteria": {"energy": at_most(math.inf, 1.0)}, "passed": False}]
     record = {"cases": cases, "config": {"quick": True}, "run_time_s": 1.0, "notes": ["n1"]}
-    text = bench_stress.markdown_report(record)
-    assert "1 of 2 cases pass; failing: lcp bad" in text and "* n1" in text
-    rows = [line for line in text.splitlines() if line.startswith("| ")]
-    assert len(rows) == 3 and "**energy inf <= 1 FAIL**" in rows[2]
-    assert "eps=0.25" in rows[1] and "dt=0.001,0.002" in rows[2]
+    text = bench_stress.verdict(record)
+    assert text.splitlines() == [
+        "Stress test (quick): 1 of 2 cases pass; failing: lcp bad. Run time 1 s.", "* n1"]
+    assert [bench_stress.margin(c["criteria"][k]) for c, k in
+            ((cases[0], "dishonest_results"), (cases[1], "energy"))] == [1e-9, 1e9]
     bench_stress.plot_margins(cases, tmp_path / "stress.png")
     assert (tmp_path / "stress.png").stat().st_size > 5_000
     bench_stress.report.write_json(bench_stress.report.json_safe(record), tmp_path / "s.json")
