@@ -8,7 +8,7 @@ substeps per call and the brake stop, each against MuJoCo's arm where it applies
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -134,9 +134,6 @@ def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
     stepper.tau[:] = tau
     if brake is not None:
         stepper.brake_bound[:] = brake
-    stepper.step()  # its first call (compiles or loads) before the timing's own warm-up call
-    stepper.q[:] = q
-    stepper.u[:] = u
     step = stepper.step
     steps = range(IN_PLACE_STEPS_PER_CALL)
 
@@ -146,6 +143,7 @@ def _in_place_call(st: MoreauJeanStepper, arrays: tuple) -> Callable[[], Any]:
         stepper.q[:] = q
         stepper.u[:] = u
 
+    call()  # the first calls (compile or load) before the timing's own warm-up call
     return call
 
 
@@ -388,7 +386,7 @@ def case_record(case: Any) -> dict[str, Any]:
 
 
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],
-                 path: Path, targets_us: Mapping[str, float] = TARGETS_US) -> None:
+                 path: Path) -> None:
     """µs per copy-step against N (and against substeps per call), one line per model."""
     panels = 2 if substeps else 1
     fig, axes = plt.subplots(1, panels, figsize=(7.5 + 4.5 * (panels - 1), 4.8), sharey=True,
@@ -402,8 +400,8 @@ def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str,
     for model, key, color in (("manipulator", "manipulator_batched", "tab:green"),
                               ("diff_drive", "diff_drive", "tab:red")):
         if any(r["model"] == model for r in batched):
-            axes[0].axhline(targets_us[key], color=color, lw=0.9, ls=":",
-                            label=f"{model} target {targets_us[key]:g} µs")
+            axes[0].axhline(TARGETS_US[key], color=color, lw=0.9, ls=":",
+                            label=f"{model} target {TARGETS_US[key]:g} µs")
     axes[0].set_title("Batched stepping (single thread), per copy-step")
     axes[0].set_ylabel("µs per copy-step (band: quartiles)")
     axes[0].legend(fontsize=7, loc="best")
@@ -411,14 +409,14 @@ def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str,
 
 
 def plot_single_step(single: Sequence[dict[str, Any]], scenes: Sequence[dict[str, Any]],
-                     path: Path, targets_us: Mapping[str, float] = TARGETS_US) -> None:
+                     path: Path) -> None:
     """Horizontal bars per (model, scene): Python step, in-place step, in-kernel step [µs]."""
     index = {(r["model"], r["scene"], r["entry"]): r["median_s"] * 1e6 for r in single}
     index.update({(r["model"], r["scene"], "kernel"): r["per_copy_step_s"] * 1e6 for r in scenes})
     keys = list(dict.fromkeys((r["model"], r["scene"]) for r in single))
     fig, ax = plt.subplots(figsize=(8.5, 0.42 * len(keys) + 1.6))
-    ax.axvline(targets_us["manipulator_python"], color="tab:green", lw=0.9, ls=":",
-               label=f"manipulator target (Python) {targets_us['manipulator_python']:g} µs")
+    ax.axvline(TARGETS_US["manipulator_python"], color="tab:green", lw=0.9, ls=":",
+               label=f"manipulator target (Python) {TARGETS_US['manipulator_python']:g} µs")
     bars(ax, [f"{m} / {s}" for m, s in keys], {
         "one step from Python: step() / mj_step": [
             index.get((m, s, "mj_step" if m == "mujoco" else "step")) for m, s in keys],

@@ -6,8 +6,8 @@
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -16,7 +16,7 @@ import numpy as np
 from benchmarks import report
 from benchmarks.problems import peer_data_dir
 from benchmarks.report import plt
-from benchmarks.timing import arguments
+from benchmarks.timing import TimingPlan, arguments, time_interleaved
 from mdi_envs.solvers import SolverStatus, fc3d_residual, solve_fc3d
 from mdi_envs.solvers.siconos_io import read_friction_contact
 
@@ -30,18 +30,8 @@ METHODS: dict[str, dict[str, Any]] = {
 """Method -> options of the run (budgets: Newton steps or sweeps)."""
 
 QUICK_MAX_N = 150
-REPEAT_BELOW_S = 0.02
-
-
-def time_solve(data: Any, method: str, options: dict[str, Any]) -> tuple[Any, float]:
-    """Solve once (repeated while short) and return the result and the median time in s."""
-    times = []
-    while True:
-        start = time.perf_counter()
-        result = solve_fc3d(data.W, data.q, data.mu, method=method, tol=TOL, **options)
-        times.append(time.perf_counter() - start)
-        if sum(times) > REPEAT_BELOW_S * 5 or times[0] > REPEAT_BELOW_S or len(times) >= 50:
-            return result, float(np.median(times))
+PLAN = TimingPlan(budget_s=0.1, min_rounds=1, max_rounds=50, min_batch_s=0.0)
+"""Each solve: one untimed call, then single calls for about 0.1 s (at most 50); the median."""
 
 
 def run(output: Path, quick: bool) -> str:
@@ -63,7 +53,9 @@ def run(output: Path, quick: bool) -> str:
                 continue
             row: dict[str, Any] = {"name": path.stem, "n": n, "contacts": n // 3}
             for method, options in METHODS.items():
-                result, seconds = time_solve(data, method, options)
+                timed = time_interleaved({method: partial(
+                    solve_fc3d, data.W, data.q, data.mu, method=method, tol=TOL, **options)}, PLAN)
+                result, seconds = timed[method].result, timed[method].median_s
                 row[method] = {"time_s": seconds, "status": result.status.name,
                                "residual": float(fc3d_residual(data.W, data.q, data.mu, result.r)),
                                "iterations": int(result.num_iter),

@@ -167,12 +167,13 @@ class Copies:
         self.q, self.u = self.q0.copy(), self.u0.copy()
         self.tau = np.zeros((n, stepper.num_inputs))
         self.brake = np.zeros((n, stepper.num_brakes))
-        self.out = (np.empty((n, stepper.num_impulses)), np.empty((n, stepper.info_size)))
+        self.out = (np.zeros((n, stepper.num_impulses)), np.empty((n, stepper.info_size)))
 
     def reset(self) -> None:
-        """Back to the initial states."""
+        """Back to the initial states, and to a cold start of the (spatial) warm-start impulses."""
         self.q[:] = self.q0
         self.u[:] = self.u0
+        self.out[0][:] = 0.0
 
     def command(self, tau: Sequence[float], brake: Sequence[float] = ()) -> None:
         """Set every copy's inputs (m,) and brake bounds (k,) (inf: ideal brake)."""
@@ -674,11 +675,8 @@ def pareto_front(points: Sequence[Mapping[str, Any]]) -> list[tuple[float, float
     """(wall time [s], error, label) of the points no other point beats in both, by time."""
     usable = sorted((p["wall_time_s"], p["error"], f"{p['series']} dt={p['value']:g}")
                     for p in points if p.get("error") is not None and p["wall_time_s"] is not None)
-    front: list[tuple[float, float, str]] = []
-    for seconds, error, label in usable:
-        if not front or error < front[-1][1]:
-            front.append((seconds, error, label))
-    return front
+    return [entry for i, entry in enumerate(usable)
+            if all(entry[1] < earlier[1] for earlier in usable[:i])]
 
 
 def interpolate_front(front: Sequence[tuple[float, float, str]], seconds: float

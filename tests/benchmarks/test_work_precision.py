@@ -60,7 +60,7 @@ def test_outputs_exist_and_are_consistent(quick: tuple[Path, dict[str, Any]]) ->
     report = wp.summary(record, ("numpy",))
     header = next(line for line in report.splitlines() if line.startswith("| target "))
     assert "**Targets**" in report and header.split("|")[2].strip() == "threshold"
-    assert sum(line.startswith("| ball ") for line in report.splitlines()) == len(
+    assert sum(line.startswith("| ball") for line in report.splitlines()) == len(
         record["targets"])
 
 
