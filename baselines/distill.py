@@ -16,8 +16,10 @@ configuration (one env step per transcription interval of the reference):
   minibatches, the learning rate decaying from ``learning_rate`` to a tenth in each round).
 
 After each round the learner plays ``validation`` perturbed starts alone (the same starts every
-round); the round whose learner succeeds most often (the later one on a tie) is the policy
-returned, as in Ross et al.'s choice of the best policy on validation.
+round); the round whose learner succeeds most often, and among those the one with the lowest mean
+cost (time or effort) over its successes (the later one on a tie), is the policy returned:
+Ross et al.'s choice of the best policy on validation, in the tables' order (success, then the
+ratio).
 
 Perturbed starts draw the start noise half-width ``reset_noise_scale`` log-uniformly in
 ``SCALES`` [rad, rad/s, m, m/s] and reset seeds from ``FIRST_TRAINING_SEED`` on, apart from the
@@ -131,6 +133,8 @@ class Distillation:
         losses: the training loss (``imitation_loss`` on all the data) after each round.
         mixture_success: success rate of each round's episodes (round 0: the expert's).
         validation_success: the learner's alone after each round (``DAggerSettings``).
+        validation_cost: the learner's mean time [s] or effort [N^2 m^2 s] over those successes
+            after each round (None: none succeeded).
         best_round: the round whose learner is returned.
     """
 
@@ -143,6 +147,7 @@ class Distillation:
     losses: list[float]
     mixture_success: list[float]
     validation_success: list[float]
+    validation_cost: list[float | None]
     best_round: int
 
 
@@ -310,6 +315,18 @@ def learner_policy(model: Any) -> Callable[[Any], Callable[[Any], Any]]:
     return lambda _env: lambda observation: model.predict(observation, deterministic=True)[0]
 
 
+def validation_cost(episodes: list[Any], objective: str) -> float | None:
+    """Mean time [s] (``objective`` "time") or effort over the successful ``episodes``."""
+    costs = [episode.elapsed_time if objective == "time" else episode.effort
+             for episode in episodes if episode.is_success]  # fmt: skip
+    return float(np.mean(costs)) if costs else None
+
+
+def validation_rank(success: float, cost: float | None) -> tuple[float, float]:
+    """Sort key of a round's validation: more success first, then less cost."""
+    return -success, math.inf if cost is None else cost
+
+
 def perturbed_starts(rng: np.random.Generator, count: int) -> list[tuple[float, int]]:
     """``count`` (start noise half-width log-uniform in ``SCALES``, reset seed) pairs."""
     low, high = np.log(SCALES)
@@ -336,7 +353,8 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
         raise ValueError(f"no distillation task {env_id!r}; known: {', '.join(TASKS)}")
     if expert not in EXPERTS:
         raise ValueError(f"unknown expert {expert!r}; known: {', '.join(EXPERTS)}")
-    controller = EXPERTS[expert](env_id, OBJECTIVES[env_id][0])
+    objective = OBJECTIVES[env_id][0]
+    controller = EXPERTS[expert](env_id, objective)
     if controller is None:
         raise ValueError(f"expert {expert!r} is not available here (the MPCs need CasADi)")
     th.set_num_threads(1)  # tiny networks: more threads only add synchronisation
@@ -346,7 +364,7 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
     model: Any = None  # made after round 0, whose expert data give the observation statistics
     labels = _Labels([], [])
     validation = perturbed_starts(rng, settings.validation)
-    sizes, losses, mixture, validated = [], [], [], []
+    sizes, losses, mixture, validated, costs = [], [], [], [], []
     best, best_round = None, 0
     for round_ in range(settings.rounds + 1):
         beta = settings.beta_decay**round_
@@ -361,13 +379,15 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
                                      np.array(labels.observations))  # fmt: skip
             losses.append(fit(model.policy, np.array(labels.observations),
                               np.array(labels.actions), settings, rng))  # fmt: skip
-            validated.append(float(np.mean([
-                play(env_id, learner_policy(model), reset_seed,
-                     **{**env_kwargs, "reset_noise_scale": scale}).is_success
-                for scale, reset_seed in validation])))  # fmt: skip
+            episodes = [play(env_id, learner_policy(model), reset_seed,
+                             **{**env_kwargs, "reset_noise_scale": scale})
+                        for scale, reset_seed in validation]  # fmt: skip
+        validated.append(float(np.mean([episode.is_success for episode in episodes])))
+        costs.append(validation_cost(episodes, objective))
         sizes.append(len(labels.actions))
         mixture.append(float(np.mean(reached)))
-        if best is None or validated[-1] >= validated[best_round]:
+        score = validation_rank(validated[-1], costs[-1])
+        if best is None or score <= validation_rank(validated[best_round], costs[best_round]):
             best, best_round = copy.deepcopy(model.policy.state_dict()), round_
         if log is not None:
             log(f"round {round_}: beta {beta:.3f}, {sizes[-1]} samples, loss {losses[-1]:.3f}, "
@@ -375,7 +395,7 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
                 f"expert {labels.cpu_s:.1f} s")
     model.policy.load_state_dict(best)
     record = Distillation(expert, controller.label, settings, labels.calls, labels.cpu_s, sizes,
-                          losses, mixture, validated, best_round)  # fmt: skip
+                          losses, mixture, validated, costs, best_round)  # fmt: skip
     if dataset is not None:
         write_labels(env_id, controller, labels.episodes, dataset,
                      f"DAgger seed {seed}, expert {controller.label}, {settings}")  # fmt: skip
@@ -531,5 +551,6 @@ __all__ = [
     "ALGO", "DEFAULT_OUTPUT", "FIRST_TRAINING_SEED", "SCALES", "DAgger",
     "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill",
     "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs", "learner_policy",
-    "make_learner", "native_action", "perturbed_starts", "play_labelled", "write_labels",
+    "make_learner", "native_action", "perturbed_starts", "play_labelled", "validation_cost",
+    "validation_rank", "write_labels",
 ]

@@ -29,6 +29,8 @@ from baselines.distill import (  # noqa: E402
     make_learner,
     native_action,
     play_labelled,
+    validation_cost,
+    validation_rank,
 )
 from baselines.evaluation import (  # noqa: E402
     DIFF_DRIVE_EFFORT_V1,
@@ -37,6 +39,7 @@ from baselines.evaluation import (  # noqa: E402
     play,
 )
 from baselines.model_based import lqr_controller  # noqa: E402
+from baselines.records import Episode  # noqa: E402
 
 TINY = DAggerSettings(rounds=1, episodes=2, gradient_steps=400, net_arch=(32, 32), validation=1)
 
@@ -72,7 +75,10 @@ def test_dagger_imitates_the_expert_on_held_out_states(tmp_path: Path,
     assert record.expert_calls == record.dataset_sizes[-1] == 5 * 100
     assert record.dataset_sizes == [300, 500] and record.expert_cpu_s > 0.0
     assert len(record.losses) == len(record.mixture_success) == len(record.validation_success) == 2
-    assert record.best_round in (0, 1)
+    assert len(record.validation_cost) == 2
+    ranks = [validation_rank(success, cost) for success, cost
+             in zip(record.validation_success, record.validation_cost, strict=True)]
+    assert record.best_round == max(r for r in range(2) if ranks[r] == min(ranks))
     # the labelled episodes as a Minari dataset: a fresh expert relabels them identically
     dataset = minari.load_dataset(name)
     assert dataset.total_episodes == 5 and dataset.total_steps == record.expert_calls
@@ -123,6 +129,19 @@ def test_the_hybrid_label_plays_exactly_the_experts_box_action() -> None:
         assert other_reward == reward
     assert engaged == {0, 1}  # the reference brakes and releases within these steps
     np.testing.assert_array_equal(expert_label(np.array([0.5, -1.0]), hybrid=False), [0.5, -1.0])
+
+
+def test_the_best_round_succeeds_most_and_then_costs_least() -> None:
+    def episode(success: bool, time: float, effort: float) -> Episode:
+        return Episode(0, success, time, effort, 0, 0.0)
+
+    played = [episode(True, 4.0, 3.0), episode(True, 5.0, 1.0), episode(False, 1.0, 0.1)]
+    assert validation_cost(played, "time") == 4.5  # failures do not count
+    assert validation_cost(played, "effort") == 2.0
+    assert validation_cost([episode(False, 1.0, 1.0)], "time") is None
+    rounds = [(0.9, 4.0), (1.0, 5.0), (1.0, 4.5), (0.0, None)]
+    assert min(range(4), key=lambda r: validation_rank(*rounds[r])) == 2
+    assert validation_rank(0.0, None) > validation_rank(0.1, 100.0)
 
 
 def test_bad_requests_are_errors(tmp_path: Path) -> None:
