@@ -281,6 +281,19 @@ class ShrinkingHorizonMPC:
                    else np.zeros(0, dtype=bool))
         return plan.tau[0].copy(), engaged.copy()
 
+    def replan(self, step: int, q: FloatArray, u: FloatArray) -> Plan | None:
+        """One re-solve of the problem remaining at env step ``step`` from the state (q, u).
+
+        Warm-started from the reference's rest, with its pattern (and the fallbacks of a
+        control step); None if none of them found a plan. The episode's records are left as
+        they are.
+        """
+        guess = _reference_plan(self.reference)
+        for _ in range(step):
+            guess = guess.shifted()
+        solve, plan, _ = self._solve(guess, q, u)
+        return None if solve is None else plan
+
     def decode(self, observation: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(q, u) from an observation; angles unwrapped against the plan's prediction."""
         return decode_observation(observation, self._predicted_q(),

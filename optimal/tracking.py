@@ -25,6 +25,19 @@ cannot make up the lag, and engaging on time locks the joint short of the goal. 
 also solves window k - 1, the reference one step later, from the measured state and applies the
 plan of lower objective; taking it delays the rest of the episode by one step (``delays``).
 
+At each interval k at which the reference's torque reverses (references in ``REPLAN``: the
+manipulator's swing turns from accelerating to braking at interval 60 of 120) the controller
+re-solves the whole remaining problem once from the measured state
+(``optimal.mpc.ShrinkingHorizonMPC.replan``: the reference's mode pattern on the env's grid,
+arriving on time, with the goal relaxed or 1-3 steps later) and tracks that plan instead of the
+reference's rest, later by the steps it arrives later (``replans``; a plan of another pattern
+is not taken). A window tracks the reference's state: from a start that lags the reference
+there it kept the torque at its bound 3-4 steps past the reversal to catch up, after which no
+plan of the pattern arrived within 3 steps, and the brake locked the arm 0.12 rad past the
+goal, from where it crept in (0.1-perturbed starts 12, 15, 18, 19: 1.27-1.34x the optimal
+time; the plan re-solved at the reversal brakes at once, and they take 0.983x). The re-solve
+costs 0.6-6 s of CPU time at that one step.
+
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
 dual start) (``Opti.to_function``); a control step is one call. Its primal start is the last
@@ -106,6 +119,10 @@ effort reference ends in a skid whose length grows as the friction falls: on a f
 less grip the window must reach from before the skid to the fixed horizon (1.6 s) to slow the
 robot in time; at 15 or 30 intervals it ends the skid 0.07-0.2 m past the goal."""
 
+REPLAN = ("manipulator_time",)
+"""References whose tracker re-solves the remaining problem at the reference's torque reversals
+(see the module docstring)."""
+
 DEFAULT_HORIZON = 15
 """The window of references not in ``HORIZON``."""
 
@@ -179,7 +196,10 @@ class TrackingMPC(StateFeedbackPolicy):
         traction: the ``FrictionEstimator`` (None: a model without friction contacts).
         friction_factors: its estimate at each step of this episode.
         delays: steps of this episode at which the reference was taken one step later (a brake
-            engaged one step later, see the module docstring).
+            engaged one step later, or a re-plan arriving later, once per step it is later;
+            see the module docstring).
+        replans: steps of this episode at which the remaining problem was re-solved and its plan
+            taken (``REPLAN``, see the module docstring).
         index_on_less_friction: state-indexed only from the step at which the friction
             estimate is first below 1 this episode (see the module docstring); False (default):
             state-indexed whenever ``index_window`` is set.
@@ -225,6 +245,11 @@ class TrackingMPC(StateFeedbackPolicy):
         self._terminal = np.concatenate([self.lqr.cost_to_go,
                                          np.repeat(self.lqr.hold_cost_to_go[None], extension, 0)])
         self._windows: dict[bytes, _Window] = {}
+        torque = np.sign(reference.tau)
+        self._reversals = set(np.flatnonzero(np.any(
+            torque[1:] * torque[:-1] < 0, axis=1)) + 1) if reference.name in REPLAN else set()
+        self._reference_x, self._reference_tau = self._x, self._tau
+        self._full: Any = None
         self._keys = [self._window(k) for k in range(steps + (1 if extension else 0))]
         self._reference_points = [self._reference_point(k) for k in range(len(self._keys))]
         self._reference_multipliers = [self._reference_multiplier(k)
@@ -234,6 +259,8 @@ class TrackingMPC(StateFeedbackPolicy):
         self.iterations: list[int] = []
         self.friction_factors: list[float] = []
         self.delays: list[int] = []
+        self.replans: list[int] = []
+        self._replanned: set[int] = set()
         self._previous: tuple[_Window, FloatArray, FloatArray, int] | None = None
         self._measured: tuple[FloatArray, FloatArray, FloatArray] | None = None
         self.index_on_less_friction = False
@@ -242,7 +269,9 @@ class TrackingMPC(StateFeedbackPolicy):
     def reset(self) -> None:
         """A new episode: step counter, records, warm start and friction estimate start again."""
         self.compute_times, self.fallbacks, self.iterations = [], [], []
-        self.friction_factors, self.delays = [], []
+        self.friction_factors, self.delays, self.replans = [], [], []
+        self._replanned = set()
+        self._x, self._tau = self._reference_x, self._reference_tau
         self._previous = self._measured = None
         self._less_friction = False
         if self.traction is not None:
@@ -290,6 +319,10 @@ class TrackingMPC(StateFeedbackPolicy):
             if not self.has_brake:
                 return self.lqr.control(step, q, u)
         k = min(step - len(self.delays), len(self._keys) - 1)
+        if k in self._reversals and k not in self._replanned:
+            self._replanned.add(k)
+            self._replan(step, k, q, u)
+            k = min(step - len(self.delays), len(self._keys) - 1)
         plan = self._solve(k, q, u, extra)
         iterations = plan.iterations
         if self._engages(k):  # the reference one step later: the brake engaged one step later
@@ -306,6 +339,29 @@ class TrackingMPC(StateFeedbackPolicy):
         self._previous = (plan.window, plan.x, plan.multipliers, k)
         tau0 = plan.tau.reshape(-1, plan.window.shapes[0][1] - 1)[:, 0]
         return np.clip(tau0, -self.torque_bound, self.torque_bound), brake
+
+    def _replan(self, step: int, k: int, q: FloatArray, u: FloatArray) -> None:
+        """The remaining problem re-solved at env step ``step`` (reference interval k), taken.
+
+        Its plan replaces the reference's rest from interval k - d on, d the steps it arrives
+        later (see the module docstring), if it has the reference's mode pattern.
+        """
+        from optimal.mpc import ShrinkingHorizonMPC
+
+        if self._full is None:
+            self._full = ShrinkingHorizonMPC(self.reference, grid="env")
+        plan = self._full.replan(k, q, u)
+        steps = len(self.reference.tau)
+        later = 0 if plan is None else plan.num_intervals - (steps - k)
+        if plan is None or k - later < 0 or plan.modes.key() != ModePattern(
+                *(None if rows is None else rows[:, k - later:steps]
+                  for rows in self._modes)).key():
+            return
+        self._x, self._tau = self._x.copy(), self._tau.copy()
+        self._x[k - later:steps + 1] = np.hstack([plan.q, plan.u])
+        self._tau[k - later:steps] = plan.tau
+        self.delays += [step] * later
+        self.replans.append(step)
 
     def _engages(self, k: int) -> bool:
         """Whether interval k engages a brake released over k - 1, in a window into the hold.
@@ -442,5 +498,5 @@ def _reference_modes(reference: Reference) -> tuple[np.ndarray | None, np.ndarra
     return modes.engaged, modes.sliding
 
 
-__all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "SOLVER_OPTIONS", "WARM_START_PUSH",
-           "TrackingMPC"]
+__all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "REPLAN", "SOLVER_OPTIONS",
+           "WARM_START_PUSH", "TrackingMPC"]
