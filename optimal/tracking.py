@@ -36,7 +36,7 @@ there it kept the torque at its bound 3-4 steps past the reversal to catch up, a
 plan of the pattern arrived within 3 steps, and the brake locked the arm 0.12 rad past the
 goal, from where it crept in (0.1-perturbed starts 12, 15, 18, 19: 1.27-1.34x the optimal
 time; the plan re-solved at the reversal brakes at once, and they take 0.983x). The re-solve
-costs 0.6-6 s of CPU time at that one step.
+costs 0.6-4.3 s of CPU time at that one step.
 
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and

@@ -10,6 +10,7 @@ import pytest
 
 casadi = pytest.importorskip("casadi")
 
+from mdi_envs.maneuvers import MANIPULATOR_MANEUVER  # noqa: E402
 from mdi_envs.rollout import rollout  # noqa: E402
 from optimal.references import load_reference  # noqa: E402
 from optimal.replay import env_options  # noqa: E402
@@ -192,3 +193,50 @@ def test_a_step_behind_at_the_last_engagement_it_engages_the_brake_a_step_later(
     _, brake = controller.control(k, reference.q[k - 1], reference.u[k - 1])
     assert controller.delays == [k] and brake[0] == 0.0
     np.testing.assert_array_equal(controller.predicted_q(k + 1), reference.q[k])
+
+
+def _reversal(reference) -> int:
+    """The reference interval at which the manipulator's torque turns from + to -."""
+    torque = np.sign(reference.tau[:, 0])
+    return int(np.flatnonzero(torque[1:] * torque[:-1] < 0)[0]) + 1
+
+
+def test_on_the_reference_at_the_torque_reversal_the_re_solved_rest_is_the_reference(
+        controller: TrackingMPC) -> None:
+    """The remaining problem re-solved from the reference's own state k arrives on time, along it.
+
+    A reset tracks the reference again.
+    """
+    reference = controller.reference
+    k = _reversal(reference)
+    controller.reset()
+    controller.control(k, reference.q[k], reference.u[k])
+    assert controller.replans == [k] and controller.delays == []
+    np.testing.assert_allclose(controller.predicted_q(len(reference.tau)), reference.q[-1],
+                               atol=1e-4)
+    deviation = max(np.max(np.abs(controller.predicted_q(j) - reference.q[j]))
+                    for j in range(k, len(reference.tau) + 1))
+    assert deviation < 0.02
+    controller.reset()
+    assert controller.replans == []
+    np.testing.assert_array_equal(controller.predicted_q(k + 1), reference.q[k + 1])
+
+
+def test_a_step_behind_at_the_torque_reversal_it_tracks_the_re_solved_rest(
+        controller: TrackingMPC) -> None:
+    """From the reference's state k - 1 at step k the plan tracked starts at that state.
+
+    It ends at rest within the goal's tolerances, at most 3 steps after the reference.
+    """
+    reference = controller.reference
+    k = _reversal(reference)
+    controller.reset()
+    controller.control(k, reference.q[k - 1], reference.u[k - 1])
+    later = len(controller.delays)
+    assert controller.replans == [k] and later <= 3
+    start = controller._x[k - later]
+    np.testing.assert_allclose(start, np.concatenate([reference.q[k - 1], reference.u[k - 1]]))
+    end = controller._x[len(reference.tau)]
+    n = end.size // 2
+    assert np.all(np.abs(end[:n] - reference.q[-1]) <= MANIPULATOR_MANEUVER.angle_tolerance)
+    assert np.all(np.abs(end[n:]) <= MANIPULATOR_MANEUVER.velocity_tolerance)
