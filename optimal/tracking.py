@@ -25,9 +25,9 @@ cannot make up the lag, and engaging on time locks the joint short of the goal. 
 also solves window k - 1, the reference one step later, from the measured state and applies the
 plan of lower objective; taking it delays the rest of the episode by one step (``delays``).
 
-At each interval k at which the reference's torque reverses (references in ``REPLAN``: the
-manipulator's swing turns from accelerating to braking at interval 60 of 120) the controller
-re-solves the whole remaining problem once from the measured state
+At each interval k at which the reference's torque reverses (time-indexed, references in
+``REPLAN``: the manipulator's swing turns from accelerating to braking at interval 60 of 120)
+the controller re-solves the whole remaining problem once from the measured state
 (``optimal.mpc.ShrinkingHorizonMPC.replan``: the reference's mode pattern on the env's grid,
 arriving on time, with the goal relaxed or 1-3 steps later) and tracks that plan instead of the
 reference's rest, later by the steps it arrives later (``replans``; a plan of another pattern
@@ -36,7 +36,7 @@ there it kept the torque at its bound 3-4 steps past the reversal to catch up, a
 plan of the pattern arrived within 3 steps, and the brake locked the arm 0.12 rad past the
 goal, from where it crept in (0.1-perturbed starts 12, 15, 18, 19: 1.27-1.34x the optimal
 time; the plan re-solved at the reversal brakes at once, and they take 0.983x). The re-solve
-costs 0.6-4.3 s of CPU time at that one step.
+costs 0.6-5.4 s of CPU time at that one step.
 
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
@@ -319,7 +319,7 @@ class TrackingMPC(StateFeedbackPolicy):
             if not self.has_brake:
                 return self.lqr.control(step, q, u)
         k = min(step - len(self.delays), len(self._keys) - 1)
-        if k in self._reversals and k not in self._replanned:
+        if k in self._reversals and k not in self._replanned and not self.is_state_indexed():
             self._replanned.add(k)
             self._replan(step, k, q, u)
             k = min(step - len(self.delays), len(self._keys) - 1)

@@ -205,7 +205,7 @@ def test_on_the_reference_at_the_torque_reversal_the_re_solved_rest_is_the_refer
         controller: TrackingMPC) -> None:
     """The remaining problem re-solved from the reference's own state k arrives on time, along it.
 
-    A reset tracks the reference again.
+    A reset tracks the reference again; a state-indexed controller does not re-plan.
     """
     reference = controller.reference
     k = _reversal(reference)
@@ -220,6 +220,13 @@ def test_on_the_reference_at_the_torque_reversal_the_re_solved_rest_is_the_refer
     controller.reset()
     assert controller.replans == []
     np.testing.assert_array_equal(controller.predicted_q(k + 1), reference.q[k + 1])
+    controller.index_window = 10  # state-indexed: the reference's own nodes, never re-planned
+    try:
+        controller.control(k, reference.q[k], reference.u[k])
+        assert controller.replans == []
+    finally:
+        controller.index_window = 0
+        controller.reset()
 
 
 def test_a_step_behind_at_the_torque_reversal_it_tracks_the_re_solved_rest(
