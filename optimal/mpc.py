@@ -284,14 +284,14 @@ class ShrinkingHorizonMPC:
     def replan(self, step: int, q: FloatArray, u: FloatArray) -> Plan | None:
         """One re-solve of the problem remaining at env step ``step`` from the state (q, u).
 
-        Warm-started from the reference's rest, with its pattern (and the fallbacks of a
-        control step); None if none of them found a plan. The episode's records are left as
-        they are.
+        Warm-started from the reference's rest, with its pattern: the fallbacks of a control
+        step that keep it (the goal relaxed, a later arrival); None if none found a plan. The
+        episode's records are left as they are.
         """
         guess = _reference_plan(self.reference)
         for _ in range(step):
             guess = guess.shifted()
-        solve, plan, _ = self._solve(guess, q, u)
+        solve, plan, _ = self._solve(guess, q, u, other_patterns=False)
         return None if solve is None else plan
 
     def decode(self, observation: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -377,14 +377,17 @@ class ShrinkingHorizonMPC:
         transcription.set_guess(start_q, start_u, guess.tau, guess.final_time, guess.impulses)
         return transcription.initial_point()
 
-    def _solve(self, guess: Plan, q: FloatArray,
-               u: FloatArray) -> tuple[ModeSolve | None, Plan, str]:
-        """The step's plan: fixed pattern, neighbours, goal relaxed, later arrival, freed."""
+    def _solve(self, guess: Plan, q: FloatArray, u: FloatArray,
+               other_patterns: bool = True) -> tuple[ModeSolve | None, Plan, str]:
+        """The step's plan: fixed pattern, neighbours, goal relaxed, later arrival, freed.
+
+        ``other_patterns`` False: without the neighbours and the freed pattern.
+        """
         initial = self._initial_point(guess, q, u)
         solve, transcription = self._fixed(guess.modes, False, q, u, initial)
         if self._acceptable(solve, guess):
             return solve, _plan_of(solve, transcription), ""
-        if guess.num_intervals > 1:
+        if other_patterns and guess.num_intervals > 1:
             candidates = [self._fixed(pattern, False, q, u, initial)
                           for pattern in _imminent_neighbours(guess.modes)]
             accepted = [pair for pair in candidates if self._acceptable(pair[0], guess)]
@@ -403,6 +406,8 @@ class ShrinkingHorizonMPC:
                                                    longer_initial)
                 if self._acceptable(solve, longer):
                     return solve, _plan_of(solve, transcription), f"{extra} step(s) later"
+        if not other_patterns:
+            return None, guess, "open loop"
         longest = guess
         if extra_steps:  # freed over the longest horizon allowed
             longest = guess.delayed(extra_steps)
