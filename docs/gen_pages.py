@@ -34,6 +34,7 @@ from baselines.tables import (
     robustness_table,
 )
 from optimal import available_references, load_reference
+from optimal.convergence import study_limit, study_table
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "docs")]  # benchmarks/ is not installed
@@ -408,25 +409,41 @@ def references_page() -> None:
 
 
 def refinement_section(study: dict[str, Any]) -> list[str]:
-    """The discrete optimum per N against the continuous one (``optimal.convergence``)."""
-    optimum = study["continuous_cost"]
-    levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
-    distance = [level["cost"] - optimum for level in levels]
-    rows = [{"N": level["num_intervals"], "t_f, pattern projected [s]": level["start_cost"],
-             "t_f after the mode search [s]": level["cost"], "search rounds": level["max_rounds"],
-             "distance [s]": d, "distance / optimum": d / optimum,
-             "observed order": (math.log(d / distance[i + 1]) / math.log(
-                 levels[i + 1]["num_intervals"] / level["num_intervals"])
-                 if i + 1 < len(levels) else None),
-             "wall time [min]": level["wall_time"] / 60}
-            for i, (level, d) in enumerate(zip(levels, distance, strict=True))]
-    return [f"## Refinement toward the continuous optimum: {study['name']}", "",
-            f"`python -m optimal.convergence {study['name']} --levels N,...` writes "
-            f"`optimal/continuous/{study['name']}_refinement.json`: per N the discrete problem "
-            f"solved from the continuous optimum ({optimum:.7g} s), its brake phases projected "
-            "on the grid, then mode-searched for at most the given rounds "
-            "([method](../guide/polish.md#refinement-toward-the-continuous-optimum)).", "",
-            table(rows, floatfmt=".6g"), ""]
+    """The discrete optimum per N against the continuous one or the extrapolated limit.
+
+    ``optimal.convergence``: a polished continuous optimum where the study has one, else the
+    Richardson extrapolation of its three finest levels.
+    """
+    limit = study_limit(study)
+    rows = [{"N": row["num_intervals"], "cost, pattern projected": row["start_cost"],
+             "cost after the mode search": row["cost"], "search rounds": row["max_rounds"],
+             "distance": row["distance"], "distance / limit": row["relative_distance"],
+             "observed order": row["order"] if math.isfinite(row["order"]) else None,
+             "wall time [min]": row["wall_time"] / 60}
+            for row in study_table(study)]
+    name = study["name"]
+    command = (f"`python -m optimal.convergence {name} --levels N,...` writes "
+               f"`optimal/continuous/{name}_refinement.json`: per N the discrete problem ")
+    if "continuous_cost" in study:
+        return [f"## Refinement toward the continuous optimum: {name}", "",
+                command + f"solved from the continuous optimum ({limit:.7g} s), its brake phases "
+                "projected on the grid, then mode-searched for at most the given rounds "
+                "([method](../guide/polish.md#refinement-toward-the-continuous-optimum)). The "
+                "distance is to the continuous optimum.", "", table(rows, floatfmt=".6g"), ""]
+    fit = study["extrapolation"]
+    monotone = math.isfinite(fit["value"])
+    estimate = (f"The limit is **extrapolated, not polished**: cost(N) = c + a h^p through "
+                f"N = {', '.join(map(str, fit['levels']))} gives c = {fit['value']:.7g}, "
+                f"p = {fit['order']:.3f}; the three levels before give "
+                f"{fit['previous']:.7g} (uncertainty {fit['uncertainty']:.2g}, their "
+                "difference). The distance is to c." if monotone else
+                f"The three finest levels (N = {', '.join(map(str, fit['levels']))}) do not "
+                "change monotonically: no extrapolated limit, no distance.")
+    return [f"## Refinement toward the extrapolated limit: {name}", "",
+            command + "solved with the stick-slip phases of the shipped reference's finest "
+            "refinement level projected on the grid and fixed "
+            "([method](../guide/polish.md#robot-extrapolated-limits)). " + estimate, "",
+            table(rows, floatfmt=".7g"), ""]
 
 
 def search_page() -> None:

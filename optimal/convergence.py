@@ -3,16 +3,20 @@
 ``polish_reference(name)`` polishes a shipped reference's mode sequence in continuous time
 (``optimal.polish``), from its own times and from variants of its end (the last brake phase
 as an instant lock at t_f, or engaged up to t_f), and keeps the best; ``optimal/continuous/
-NAME.json`` holds it. ``solve_level`` solves the h-discrete problem on N intervals started from
-that optimum: its mode sequence on the grid (``pattern_on_grid``, so a lock at t_f is the last
-interval engaged) and its trajectory sampled there, then mode-searched. Levels are independent,
-so a study is resumable:
+NAME.json`` holds it. ``solve_level`` solves the h-discrete problem on N intervals on one
+branch: with a polished optimum, from it (its mode sequence on the grid, ``pattern_on_grid``,
+so a lock at t_f is the last interval engaged; its trajectory sampled there); without one (the
+robot, which the event-driven integrator cannot follow), from the shipped reference's finest
+refinement level (its stick-slip phases in time on the grid, ``phases_on_grid``; the shipped
+trajectory interpolated). The pattern is fixed, then mode-searched for at most a round limit.
+The limit of a study without a polished optimum is extrapolated from its three finest levels
+(``richardson``). Levels are independent, so a study is resumable:
 
     python -m optimal.convergence manipulator_time --levels 30,60,120,240,480
 
 appends each level to ``optimal/continuous/NAME_refinement.json`` when it is done (levels in
-the file are skipped) and redraws ``NAME_refinement.png``: N, t_f, the distance to the
-continuous-time optimum and the observed order log2(d_N / d_2N).
+the file are skipped) and redraws ``NAME_refinement.png``: N, the cost, the distance to the
+continuous-time optimum (or the extrapolated limit) and the observed order log2(d_N / d_2N).
 """
 
 from __future__ import annotations
@@ -28,6 +32,8 @@ from typing import Any
 import numpy as np
 
 from mdi_envs.stepping.event_driven import EventDrivenIntegrator
+from optimal.mode_search import ModeSolve, improve_modes, solve_with_modes
+from optimal.modes import ModePattern
 from optimal.polish import (
     ATOL,
     RTOL,
@@ -39,6 +45,13 @@ from optimal.polish import (
 )
 from optimal.problems import make_problem, model_of
 from optimal.references import load_reference
+from optimal.refinement import interpolated_guess
+from optimal.transcription import (
+    GUESS_IMPULSES,
+    OptimalControlProblem,
+    Transcription,
+    regridded_impulses,
+)
 
 CONTINUOUS_DIR = Path(__file__).parent / "continuous"
 """Where the continuous-time optima and the refinement studies are stored."""
@@ -85,24 +98,53 @@ def polish_reference(name: str, directory: Path = CONTINUOUS_DIR) -> dict[str, A
     return record
 
 
-def solve_level(name: str, schedule: SwitchingSchedule, num_intervals: int,
-                max_rounds: int = 8) -> dict[str, Any]:
-    """The h-discrete optimum on N intervals, started from the continuous-time ``schedule``.
+def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: int,
+                max_rounds: int = 8, warm: tuple[OptimalControlProblem, ModeSolve] | None = None
+                ) -> tuple[dict[str, Any], OptimalControlProblem, ModeSolve]:
+    """The h-discrete optimum on N intervals on one branch of ``name``.
 
-    The projected pattern is solved with its modes fixed from the sampled trajectory, then
-    mode-searched (``improve_modes``, switches +-1, +-2 intervals per move): the h-discrete
-    optimum on the continuous optimum's branch. (Freed by the continuation instead, as
-    ``optimal.refinement.refine`` does, a coarse grid moves to the branch of an earlier lock.)
+    The start: the continuous-time ``schedule`` (``schedule_start``), or for None the shipped
+    reference's finest refinement level (``reference_start``). Its pattern is solved with the
+    modes fixed, then mode-searched (``improve_modes``, switches +-1, +-2 intervals per move)
+    for at most ``max_rounds`` rounds: the h-discrete optimum on that branch. (Freed by the
+    continuation instead, as ``optimal.refinement.refine`` does, a coarse grid moves to
+    another branch.)
+
+    Args:
+        warm: (problem, solve) of a coarser level whose N divides this one: its trajectory
+            (``interpolated_guess``) replaces the start's as the initial guess (same pattern).
 
     Returns:
-        A plain-JSON record: N, cost, t_f, converged, the fixed pattern's cost, the phases [s],
-        the moves of the mode search and its round limit (0: the pattern as projected, an
-        upper bound of the branch's optimum), wall time [s].
+        A plain-JSON record: N, cost, t_f, converged, the fixed pattern's cost, whether the
+        fixed solve's modes read back as imposed (``kept_pattern``; a sliding interval with
+        zero slip reads as sticking), the phases [s], the moves of the mode search and its
+        round limit (0: the pattern as projected, an upper bound of the branch's optimum),
+        wall time [s]; then the problem and the best solve.
     """
-    from optimal.mode_search import improve_modes, solve_with_modes
-    from optimal.transcription import Transcription
-
     clock = time.perf_counter()
+    problem, pattern, guess = (reference_start(name, num_intervals) if schedule is None
+                               else schedule_start(name, schedule, num_intervals))
+    if warm is not None:
+        interpolated_guess(guess, *warm)
+    fixed = solve_with_modes(problem, pattern, initial=guess.initial_point(), transcription=guess)
+    local = improve_modes(problem, fixed, max_rounds=max_rounds)
+    best, moves = local.best, [step.move for step in local.steps]
+    phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
+    record = {"num_intervals": num_intervals, "cost": best.cost, "final_time": best.final_time,
+              "converged": best.success, "start_cost": fixed.cost,
+              "kept_pattern": fixed.found_modes.key() == pattern.key(), "phases": phases,
+              "moves": moves, "max_rounds": max_rounds,
+              "wall_time": time.perf_counter() - clock}
+    return record, problem, best
+
+
+def schedule_start(name: str, schedule: SwitchingSchedule, num_intervals: int
+                   ) -> tuple[OptimalControlProblem, ModePattern, Transcription]:
+    """(problem, pattern, guess) on N intervals from a continuous-time ``schedule``.
+
+    The pattern is ``pattern_on_grid``; the guess the schedule's event-driven run sampled on
+    the grid with t_f = the schedule's.
+    """
     problem = dataclasses.replace(make_problem(name, num_intervals),
                                   final_time=schedule.final_time)
     model, parameters = model_of(problem)
@@ -113,13 +155,54 @@ def solve_level(name: str, schedule: SwitchingSchedule, num_intervals: int,
     guess = Transcription(problem, modes=pattern)
     guess.set_guess(run.q_samples, run.u_samples, _held_inputs(schedule, problem, grid),
                     schedule.final_time)
-    fixed = solve_with_modes(problem, pattern, initial=guess.initial_point(), transcription=guess)
-    local = improve_modes(problem, fixed, max_rounds=max_rounds)
-    best, moves = local.best, [step.move for step in local.steps]
-    phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
-    return {"num_intervals": num_intervals, "cost": best.cost, "final_time": best.final_time,
-            "converged": best.success, "start_cost": fixed.cost, "phases": phases,
-            "moves": moves, "max_rounds": max_rounds, "wall_time": time.perf_counter() - clock}
+    return problem, pattern, guess
+
+
+def reference_start(name: str, num_intervals: int
+                    ) -> tuple[OptimalControlProblem, ModePattern, Transcription]:
+    """(problem, pattern, guess) on N intervals from the shipped reference ``name``.
+
+    The pattern: the phases of the reference's finest refinement level (its ``refinement``
+    metadata) on the grid of that level's t_f (``phases_on_grid``). The guess: the shipped
+    trajectory interpolated in t / t_f, its inputs, friction impulses (scaled by the step
+    ratio) and slip speeds taken from the interval holding each new interval's midpoint, t_f
+    the finest level's.
+    """
+    reference = load_reference(name)
+    finest = max(reference.metadata["refinement"]["levels"],
+                 key=lambda level: level["num_intervals"])
+    problem = make_problem(name, num_intervals)
+    if problem.cost == "time":
+        problem = dataclasses.replace(problem, final_time=finest["final_time"])
+    pattern = phases_on_grid(finest["phases"], finest["final_time"], num_intervals)
+    shipped = reference.tau.shape[0]
+    fraction, fine = reference.time / reference.final_time, np.linspace(0.0, 1.0,
+                                                                          num_intervals + 1)
+    holder = ((np.arange(num_intervals) + 0.5) * shipped / num_intervals).astype(int)
+    impulses = regridded_impulses({key: reference.arrays[key] for key in GUESS_IMPULSES},
+                                  holder, shipped / num_intervals)
+    guess = Transcription(problem, modes=pattern)
+    guess.set_guess(*(np.column_stack([np.interp(fine, fraction, c) for c in values.T])
+                      for values in (reference.q, reference.u)),
+                    reference.tau[holder], finest["final_time"], impulses)
+    return problem, pattern, guess
+
+
+def phases_on_grid(phases: dict[str, list[list[float]]], final_time: float,
+                   num_intervals: int) -> ModePattern:
+    """The pattern of ``phases`` (``ModePattern.phases``, on [0, ``final_time``]) on N intervals.
+
+    An interval is engaged (a brake) or sliding (a contact) when a phase covers its midpoint.
+    """
+    middle = (np.arange(num_intervals) + 0.5) * final_time / num_intervals
+    rows: dict[str, list[np.ndarray]] = {"brake": [], "contact": []}
+    for label in sorted(phases, key=lambda key: (key.split()[0], int(key.split()[1]))):
+        covered = np.zeros(num_intervals, dtype=bool)
+        for start, end in phases[label]:
+            covered |= (middle >= start) & (middle <= end)
+        rows[label.split()[0]].append(covered)
+    return ModePattern(*(np.array(rows[kind]) if rows[kind] else None
+                         for kind in ("brake", "contact")))
 
 
 def _held_inputs(schedule: SwitchingSchedule, problem: Any, grid: np.ndarray) -> np.ndarray:
@@ -134,16 +217,70 @@ def _held_inputs(schedule: SwitchingSchedule, problem: Any, grid: np.ndarray) ->
     return np.column_stack(columns)
 
 
+def richardson(num_intervals: list[int], costs: list[float]) -> dict[str, float]:
+    """The limit c of cost(N) = c + a h^p through three levels N, r N, r^2 N (h ~ 1/N).
+
+    Returns:
+        {"value": c, "order": p, "coefficient": a (per unit 1/N^p)}; all NaN when the three
+        costs do not change monotonically (no such fit).
+
+    Raises:
+        ValueError: not three levels with a constant ratio r > 1.
+    """
+    if len(num_intervals) != 3 or len(costs) != 3:
+        raise ValueError(f"richardson needs three levels, got N = {num_intervals}")
+    ratio = num_intervals[1] / num_intervals[0]
+    if ratio <= 1.0 or not math.isclose(num_intervals[2] / num_intervals[1], ratio):
+        raise ValueError(f"richardson needs N, r N, r^2 N with r > 1, got N = {num_intervals}")
+    first, second = costs[0] - costs[1], costs[1] - costs[2]
+    if first * second <= 0.0:
+        return {"value": math.nan, "order": math.nan, "coefficient": math.nan}
+    order = math.log(first / second) / math.log(ratio)
+    value = costs[2] - second / (ratio ** order - 1.0)
+    return {"value": value, "order": order,
+            "coefficient": (costs[2] - value) * num_intervals[2] ** order}
+
+
+def extrapolated_limit(study: dict[str, Any]) -> dict[str, Any]:
+    """``richardson`` on the three finest levels, with the spread as its uncertainty.
+
+    Returns:
+        The finest fit's "value", "order", "coefficient" and "levels"; "previous": the value
+        of the fit to the three levels before the finest (NaN with fewer than four levels);
+        "uncertainty": |value - previous|.
+    """
+    levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
+    if len(levels) < 3:
+        raise ValueError(f"{study['name']}: extrapolation needs three levels, "
+                         f"got {len(levels)}")
+
+    def fit(chosen: list[dict[str, Any]]) -> dict[str, float]:
+        return richardson([level["num_intervals"] for level in chosen],
+                          [level["cost"] for level in chosen])
+
+    finest = fit(levels[-3:])
+    previous = fit(levels[-4:-1])["value"] if len(levels) >= 4 else math.nan
+    return {**finest, "levels": [level["num_intervals"] for level in levels[-3:]],
+            "previous": previous, "uncertainty": abs(finest["value"] - previous)}
+
+
+def study_limit(study: dict[str, Any]) -> float:
+    """The study's target: the polished continuous optimum, else the extrapolated limit."""
+    if "continuous_cost" in study:
+        return float(study["continuous_cost"])
+    return float(study["extrapolation"]["value"])
+
+
 def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
     """The refinement table: one row per level, coarsest first.
 
     Rows: N, the projected pattern's cost, the cost after the mode search and its round limit,
-    the distance d_N = cost - continuous optimum, d_N / optimum, the observed order.
+    the distance d_N = cost - ``study_limit``, d_N / limit, the observed order, wall time [s].
 
     The order of a row is log(d_N / d_N') / log(N' / N) with N' the next level (NaN for the
     last row or where a distance is not positive).
     """
-    optimum = study["continuous_cost"]
+    optimum = study_limit(study)
     levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
     rows = []
     for i, level in enumerate(levels):
@@ -157,29 +294,44 @@ def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
         rows.append({"num_intervals": level["num_intervals"], "start_cost": level["start_cost"],
                      "max_rounds": level.get("max_rounds", 8), "cost": level["cost"],
                      "distance": distance, "relative_distance": distance / optimum,
-                     "order": order})
+                     "order": order, "wall_time": level["wall_time"]})
     return rows
 
 
 def plot_study(study: dict[str, Any], path: Path) -> None:
-    """Log-log plot of the distance to the continuous-time optimum against N, with slope -1."""
+    """Log-log plot of the distance to the study's limit against N, with the fitted order.
+
+    The reference line has slope -1 toward a polished optimum, -p toward an extrapolated limit
+    (``extrapolated_limit``); distances that are not positive are left out.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rows = study_table(study)
+    limit = study_limit(study)
     n = np.array([row["num_intervals"] for row in rows], dtype=float)
     distance = np.array([row["distance"] for row in rows])
-    projected = np.array([row["start_cost"] for row in rows]) - study["continuous_cost"]
+    projected = np.array([row["start_cost"] for row in rows]) - limit
+    extrapolated = "continuous_cost" not in study
+    order = study["extrapolation"]["order"] if extrapolated else 1.0
+    unit = "t_f [s]" if rows and study["levels"][str(rows[0]["num_intervals"])][
+        "cost"] == study["levels"][str(rows[0]["num_intervals"])]["final_time"] else "effort"
     figure, axes = plt.subplots(figsize=(5, 3.6))
-    axes.loglog(n, projected, "s:", color="0.5", label="pattern projected, fixed")
-    axes.loglog(n, distance, "o-", label="after the mode search")
-    axes.loglog(n, distance[-1] * n[-1] / n, "k--", lw=0.8, label="first order (slope -1)")
+    for values, style, label in ((projected, "s:", "pattern projected, fixed"),
+                                 (distance, "o-", "after the mode search")):
+        shown = values > 0
+        if shown.any():
+            axes.loglog(n[shown], values[shown], style, label=label,
+                        **({"color": "0.5"} if style == "s:" else {}))
+    if distance[-1] > 0 and math.isfinite(order):
+        axes.loglog(n, distance[-1] * (n[-1] / n) ** order, "k--", lw=0.8,
+                    label=f"order {order:.2f} (slope -{order:.2f})")
     axes.set_xlabel("N (intervals)")
-    axes.set_ylabel("t_f(N) - continuous optimum [s]")
-    axes.set_title(f"{study['name']}: continuous optimum {study['continuous_cost']:.6f} s",
-                   fontsize=9)
+    target = "extrapolated limit" if extrapolated else "continuous optimum"
+    axes.set_ylabel(f"{unit.split()[0]}(N) - {target}")
+    axes.set_title(f"{study['name']}: {target} {limit:.6f}", fontsize=9)
     axes.legend(fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
@@ -188,22 +340,39 @@ def plot_study(study: dict[str, Any], path: Path) -> None:
 
 def run_study(name: str, levels: list[int], directory: Path = CONTINUOUS_DIR,
               max_rounds: int = 8) -> dict[str, Any]:
-    """Solve the missing ``levels`` of ``name``'s study one by one, saving after each."""
-    record = json.loads((directory / f"{name}.json").read_text())
-    schedule = _schedule(record["schedule"])
+    """Solve the missing ``levels`` of ``name``'s study one by one, saving after each.
+
+    Levels run coarsest first; a converged level warm-starts the next one solved in the same
+    call when its N divides the next (``solve_level``'s ``warm``).
+
+    With a polished optimum ``NAME.json`` in ``directory`` the levels start from it and it is
+    the study's target; without one they start from the shipped reference
+    (``reference_start``) and the target is ``extrapolated_limit``, stored as "extrapolation"
+    once there are three levels.
+    """
+    polished = directory / f"{name}.json"
+    record = json.loads(polished.read_text()) if polished.exists() else None
+    schedule = _schedule(record["schedule"]) if record else None
     path = directory / f"{name}_refinement.json"
-    study = json.loads(path.read_text()) if path.exists() else {
-        "name": name, "continuous_cost": record["final_time"], "levels": {}}
-    for n in levels:
+    study = json.loads(path.read_text()) if path.exists() else {"name": name, "levels": {}}
+    if record:
+        study["continuous_cost"] = record["final_time"]
+    warm = None
+    for n in sorted(levels):
         if str(n) in study["levels"]:
             continue
-        level = solve_level(name, schedule, n, max_rounds)
+        level, *solved = solve_level(name, schedule, n, max_rounds,
+                                     warm if warm and n % warm[0].num_intervals == 0 else None)
+        warm = tuple(solved) if level["converged"] else None
         study["levels"][str(n)] = level
+        if record is None and len(study["levels"]) >= 3:
+            study["extrapolation"] = extrapolated_limit(study)
         path.write_text(json.dumps(study, indent=1) + "\n")
-        print(f"N = {n}: t_f {level['final_time']:.6f} s (start {level['start_cost']:.6f}), "
-              f"converged {level['converged']}, {len(level['moves'])} moves, "
+        print(f"N = {n}: cost {level['cost']:.6f} (start {level['start_cost']:.6f}), t_f "
+              f"{level['final_time']:.6f} s, converged {level['converged']}, kept pattern "
+              f"{level['kept_pattern']}, {len(level['moves'])} moves, "
               f"{level['wall_time']:.0f} s", flush=True)
-    if study["levels"]:
+    if "continuous_cost" in study or "extrapolation" in study:
         plot_study(study, directory / f"{name}_refinement.png")
     return study
 
@@ -224,7 +393,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--levels", default="", help="N of the refinement levels, e.g. 30,60")
     parser.add_argument("--rounds", type=int, default=8, help="mode-search rounds per level")
     args = parser.parse_args(argv)
-    if args.polish or not (CONTINUOUS_DIR / f"{args.name}.json").exists():
+    if args.polish:
         record = polish_reference(args.name)
         print(f"continuous-time optimum {record['final_time']:.6f} s ({record['best_start']}), "
               f"goal error {record['goal_error']:.1e}; h-discrete {record['discrete_cost']:.6f} "
@@ -233,12 +402,18 @@ def main(argv: list[str] | None = None) -> None:
     if levels:
         run_study(args.name, levels, max_rounds=args.rounds)
     path = CONTINUOUS_DIR / f"{args.name}_refinement.json"
-    if path.exists():  # the table, as markdown
-        print("| N | t_f, pattern projected [s] | t_f after the mode search [s] (rounds) | "
-              "distance [s] | distance / optimum | observed order |\n|---|---|---|---|---|---|")
-        for row in study_table(json.loads(path.read_text())):
+    study = json.loads(path.read_text()) if path.exists() else {}
+    if "continuous_cost" in study or "extrapolation" in study:  # the table, as markdown
+        if "extrapolation" in study:
+            print("extrapolated limit {value:.7f} (order {order:.3f}, from N = {levels}; "
+                  "the three levels before: {previous:.7f}; uncertainty {uncertainty:.1e})"
+                  .format(**study["extrapolation"]))
+        print("| N | cost, pattern projected | cost after the mode search (rounds) | "
+              "distance | distance / limit | observed order |\n|---|---|---|---|---|---|")
+        for row in study_table(study):
             print("| {num_intervals} | {start_cost:.6f} | {cost:.6f} ({max_rounds}) | "
                   "{distance:.3e} | {relative_distance:.3%} | {order:.2f} |".format(**row))
+
 
 if __name__ == "__main__":
     main()

@@ -108,7 +108,7 @@ def refine(problem: OptimalControlProblem, solve: ModeSolve, factors: Sequence[i
         fine = dataclasses.replace(at(base_n * factor), final_time=previous.solve.final_time)
         pattern = previous.solve.modes.refined(factor // previous.factor)
         guess = Transcription(fine, modes=pattern)
-        _interpolated_guess(guess, previous)
+        interpolated_guess(guess, previous.problem, previous.solve)
         fixed = solve_with_modes(fine, pattern, initial=guess.initial_point(), transcription=guess,
                                  mu_strategy=mu_strategy)
         best, moves = settle(fine, fixed, max_rounds)
@@ -144,19 +144,20 @@ def settle(problem: OptimalControlProblem, fixed: ModeSolve, max_rounds: int = 8
     return local.best, [step.move for step in local.steps]
 
 
-def _interpolated_guess(fine: Transcription, coarse: Level) -> None:
-    """Set ``fine``'s initial guess to the coarse level's trajectory.
+def interpolated_guess(fine: Transcription, coarse: OptimalControlProblem,
+                       solve: ModeSolve) -> None:
+    """Set ``fine``'s initial guess to the trajectory of ``solve``, a solution of ``coarse``.
 
-    q and u linearly interpolated, inputs held, t_f kept; the friction impulses
-    (``GUESS_IMPULSES``) held and divided by the refinement ratio, slip speeds held, the other
-    impulses zero, slacks consistent (``Transcription.set_guess``). Without the friction, the
+    ``fine.problem``'s N is an integer multiple of ``coarse``'s: q and u linearly
+    interpolated, inputs held, t_f kept; the friction impulses (``GUESS_IMPULSES``) held and
+    divided by the refinement ratio, slip speeds held, the other impulses zero, slacks
+    consistent (``Transcription.set_guess``). Without the friction, the
     robot's time-optimal refinement from N = 25 to 50 did not converge.
     """
-    arrays, final_time = read_solution(*values_at(coarse.problem, coarse.solve.modes,
-                                                  coarse.solve.point))
+    arrays, final_time = read_solution(*values_at(coarse, solve.modes, solve.point))
     big_n = fine.problem.num_intervals
-    ratio = big_n // coarse.problem.num_intervals
-    coarse_time = np.linspace(0.0, 1.0, coarse.problem.num_intervals + 1)
+    ratio = big_n // coarse.num_intervals
+    coarse_time = np.linspace(0.0, 1.0, coarse.num_intervals + 1)
     fine_time = np.linspace(0.0, 1.0, big_n + 1)
 
     def interpolated(values: np.ndarray) -> np.ndarray:
@@ -164,7 +165,7 @@ def _interpolated_guess(fine: Transcription, coarse: Level) -> None:
                                 for column in values.T])
 
     impulses = regridded_impulses({key: arrays[key] for key in GUESS_IMPULSES if key in arrays},
-                                  np.repeat(np.arange(coarse.problem.num_intervals), ratio),
+                                  np.repeat(np.arange(coarse.num_intervals), ratio),
                                   1.0 / ratio)
     fine.set_guess(interpolated(arrays["q"]), interpolated(arrays["u"]),
                    np.repeat(arrays["tau"], ratio, axis=0), final_time, impulses)
@@ -175,4 +176,4 @@ def _phases(solve: ModeSolve) -> dict[str, list[tuple[float, float]]]:
     return solve.found_modes.phases(grid)
 
 
-__all__ = ["FREEING_SCHEDULE", "Level", "Refinement", "refine", "settle"]
+__all__ = ["FREEING_SCHEDULE", "Level", "Refinement", "interpolated_guess", "refine", "settle"]
