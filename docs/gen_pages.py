@@ -415,11 +415,15 @@ def refinement_section(study: dict[str, Any]) -> list[str]:
     Richardson extrapolation of its three finest levels.
     """
     limit = study_limit(study)
+    def shown(value: float) -> float | None:
+        return value if math.isfinite(value) else None
+
     rows = [{"N": row["num_intervals"], "cost, pattern projected": row["start_cost"],
              "cost after the mode search": row["cost"], "search rounds": row["max_rounds"],
-             "distance": row["distance"], "distance / limit": row["relative_distance"],
-             "observed order": row["order"] if math.isfinite(row["order"]) else None,
-             "wall time [min]": row["wall_time"] / 60}
+             "change from the previous N": shown(row["change"]),
+             "distance": shown(row["distance"]),
+             "distance / limit": shown(row["relative_distance"]),
+             "observed order": shown(row["order"]), "wall time [min]": row["wall_time"] / 60}
             for row in study_table(study)]
     name = study["name"]
     command = (f"`python -m optimal.convergence {name} --levels N,...` writes "

@@ -112,7 +112,8 @@ def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: in
 
     Args:
         warm: (problem, solve) of a coarser level whose N divides this one: its trajectory
-            (``interpolated_guess``) replaces the start's as the initial guess (same pattern).
+            (``interpolated_guess``) replaces the start's as the initial guess (same pattern);
+            the start's guess again if IPOPT does not converge from it.
 
     Returns:
         A plain-JSON record: N, cost, t_f, converged, the fixed pattern's cost, whether the
@@ -124,9 +125,12 @@ def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: in
     clock = time.perf_counter()
     problem, pattern, guess = (reference_start(name, num_intervals) if schedule is None
                                else schedule_start(name, schedule, num_intervals))
+    start = guess.initial_point()
     if warm is not None:
         interpolated_guess(guess, *warm)
     fixed = solve_with_modes(problem, pattern, initial=guess.initial_point(), transcription=guess)
+    if warm is not None and not fixed.success:
+        fixed = solve_with_modes(problem, pattern, initial=start, transcription=guess)
     local = improve_modes(problem, fixed, max_rounds=max_rounds)
     best, moves = local.best, [step.move for step in local.steps]
     phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
@@ -163,7 +167,8 @@ def reference_start(name: str, num_intervals: int
     """(problem, pattern, guess) on N intervals from the shipped reference ``name``.
 
     The pattern: the phases of the reference's finest refinement level (its ``refinement``
-    metadata) on the grid of that level's t_f (``phases_on_grid``). The guess: the shipped
+    metadata) on the grid of that level's t_f (``phases_on_grid``, a last interval of rest
+    kept one interval long). The guess: the shipped
     trajectory interpolated in t / t_f, its inputs, friction impulses (scaled by the step
     ratio) and slip speeds taken from the interval holding each new interval's midpoint, t_f
     the finest level's.
@@ -174,7 +179,8 @@ def reference_start(name: str, num_intervals: int
     problem = make_problem(name, num_intervals)
     if problem.cost == "time":
         problem = dataclasses.replace(problem, final_time=finest["final_time"])
-    pattern = phases_on_grid(finest["phases"], finest["final_time"], num_intervals)
+    pattern = phases_on_grid(finest["phases"], finest["final_time"], num_intervals,
+                             finest["num_intervals"])
     shipped = reference.tau.shape[0]
     fraction, fine = reference.time / reference.final_time, np.linspace(0.0, 1.0,
                                                                           num_intervals + 1)
@@ -189,16 +195,23 @@ def reference_start(name: str, num_intervals: int
 
 
 def phases_on_grid(phases: dict[str, list[list[float]]], final_time: float,
-                   num_intervals: int) -> ModePattern:
+                   num_intervals: int, source_intervals: int | None = None) -> ModePattern:
     """The pattern of ``phases`` (``ModePattern.phases``, on [0, ``final_time``]) on N intervals.
 
     An interval is engaged (a brake) or sliding (a contact) when a phase covers its midpoint.
+    With ``source_intervals`` (the N the phases were read on), a phase ending where the source
+    grid's last interval starts ends where the new grid's does: that single interval of rest
+    is the terminal condition (the step into t_f ends at rest), not a phase of its length.
     """
-    middle = (np.arange(num_intervals) + 0.5) * final_time / num_intervals
+    step = final_time / num_intervals
+    middle = (np.arange(num_intervals) + 0.5) * step
+    last_start = final_time - final_time / source_intervals if source_intervals else math.nan
     rows: dict[str, list[np.ndarray]] = {"brake": [], "contact": []}
     for label in sorted(phases, key=lambda key: (key.split()[0], int(key.split()[1]))):
         covered = np.zeros(num_intervals, dtype=bool)
         for start, end in phases[label]:
+            if math.isclose(end, last_start, rel_tol=1e-9):
+                end = final_time - step
             covered |= (middle >= start) & (middle <= end)
         rows[label.split()[0]].append(covered)
     return ModePattern(*(np.array(rows[kind]) if rows[kind] else None
@@ -222,7 +235,8 @@ def richardson(num_intervals: list[int], costs: list[float]) -> dict[str, float]
 
     Returns:
         {"value": c, "order": p, "coefficient": a (per unit 1/N^p)}; all NaN when the three
-        costs do not change monotonically (no such fit).
+        costs do not change monotonically or the second change is not smaller than the first
+        (no fit with p > 0).
 
     Raises:
         ValueError: not three levels with a constant ratio r > 1.
@@ -233,7 +247,7 @@ def richardson(num_intervals: list[int], costs: list[float]) -> dict[str, float]
     if ratio <= 1.0 or not math.isclose(num_intervals[2] / num_intervals[1], ratio):
         raise ValueError(f"richardson needs N, r N, r^2 N with r > 1, got N = {num_intervals}")
     first, second = costs[0] - costs[1], costs[1] - costs[2]
-    if first * second <= 0.0:
+    if first * second <= 0.0 or abs(second) >= abs(first):
         return {"value": math.nan, "order": math.nan, "coefficient": math.nan}
     order = math.log(first / second) / math.log(ratio)
     value = costs[2] - second / (ratio ** order - 1.0)
@@ -275,10 +289,11 @@ def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
     """The refinement table: one row per level, coarsest first.
 
     Rows: N, the projected pattern's cost, the cost after the mode search and its round limit,
-    the distance d_N = cost - ``study_limit``, d_N / limit, the observed order, wall time [s].
+    its change from the previous level, the distance d_N = cost - ``study_limit`` (NaN
+    without a limit), d_N / limit, the observed order, wall time [s].
 
     The order of a row is log(d_N / d_N') / log(N' / N) with N' the next level (NaN for the
-    last row or where a distance is not positive).
+    last row or where the two distances differ in sign or one is zero).
     """
     optimum = study_limit(study)
     levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
@@ -288,10 +303,12 @@ def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
         order = math.nan
         if i + 1 < len(levels):
             following = levels[i + 1]["cost"] - optimum
-            if distance > 0 and following > 0:
+            if distance * following > 0.0:
                 order = math.log(distance / following) / math.log(
                     levels[i + 1]["num_intervals"] / level["num_intervals"])
+        change = level["cost"] - levels[i - 1]["cost"] if i else math.nan
         rows.append({"num_intervals": level["num_intervals"], "start_cost": level["start_cost"],
+                     "change": change,
                      "max_rounds": level.get("max_rounds", 8), "cost": level["cost"],
                      "distance": distance, "relative_distance": distance / optimum,
                      "order": order, "wall_time": level["wall_time"]})
@@ -299,10 +316,11 @@ def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
 
 
 def plot_study(study: dict[str, Any], path: Path) -> None:
-    """Log-log plot of the distance to the study's limit against N, with the fitted order.
+    """Log-log plot of |cost(N) - the study's limit| against N, with the fitted order.
 
     The reference line has slope -1 toward a polished optimum, -p toward an extrapolated limit
-    (``extrapolated_limit``); distances that are not positive are left out.
+    (``extrapolated_limit``); filled markers: costs above the limit, open: below. Without a
+    limit (NaN), the changes between consecutive levels.
     """
     import matplotlib
 
@@ -316,22 +334,25 @@ def plot_study(study: dict[str, Any], path: Path) -> None:
     projected = np.array([row["start_cost"] for row in rows]) - limit
     extrapolated = "continuous_cost" not in study
     order = study["extrapolation"]["order"] if extrapolated else 1.0
-    unit = "t_f [s]" if rows and study["levels"][str(rows[0]["num_intervals"])][
-        "cost"] == study["levels"][str(rows[0]["num_intervals"])]["final_time"] else "effort"
-    figure, axes = plt.subplots(figsize=(5, 3.6))
-    for values, style, label in ((projected, "s:", "pattern projected, fixed"),
-                                 (distance, "o-", "after the mode search")):
-        shown = values > 0
-        if shown.any():
-            axes.loglog(n[shown], values[shown], style, label=label,
-                        **({"color": "0.5"} if style == "s:" else {}))
-    if distance[-1] > 0 and math.isfinite(order):
-        axes.loglog(n, distance[-1] * (n[-1] / n) ** order, "k--", lw=0.8,
-                    label=f"order {order:.2f} (slope -{order:.2f})")
-    axes.set_xlabel("N (intervals)")
     target = "extrapolated limit" if extrapolated else "continuous optimum"
-    axes.set_ylabel(f"{unit.split()[0]}(N) - {target}")
-    axes.set_title(f"{study['name']}: {target} {limit:.6f}", fontsize=9)
+    curves = [(projected, "s:", "0.5", "pattern projected, fixed"),
+              (distance, "o-", "C0", "after the mode search")]
+    if not math.isfinite(limit):  # no limit: the changes between consecutive levels
+        distance = np.array([row["change"] for row in rows])
+        curves, target = [(distance, "o-", "C0", "cost(N) - cost(previous N)")], "no limit"
+    figure, axes = plt.subplots(figsize=(5, 3.6))
+    for values, style, color, label in curves:
+        axes.loglog(n, np.abs(values), style, color=color, label=label, markerfacecolor="none")
+        above = values > 0
+        axes.loglog(n[above], values[above], style[0], color=color)
+    if math.isfinite(order):
+        axes.loglog(n, abs(distance[-1]) * (n[-1] / n) ** order, "k--", lw=0.8,
+                    label=f"order {order:.2f}")
+    axes.set_xlabel("N (intervals)")
+    axes.set_ylabel(f"|cost(N) - {target}|" if math.isfinite(limit) else "|change|")
+    axes.set_title(f"{study['name']}: {target} {limit:.6f}" if math.isfinite(limit) else
+                   f"{study['name']}: the three finest levels do not converge monotonically",
+                   fontsize=9)
     axes.legend(fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=110)

@@ -83,20 +83,27 @@ def test_richardson_recovers_limit_and_order_of_a_synthetic_series() -> None:
 
 def test_richardson_reports_a_series_that_is_not_monotone() -> None:
     assert all(math.isnan(v) for v in richardson([10, 20, 40], [2.0, 1.9, 1.95]).values())
+    # monotone, but the changes grow: no fit with a positive order
+    assert all(math.isnan(v) for v in richardson([10, 20, 40], [2.0, 2.1, 2.3]).values())
     with pytest.raises(ValueError, match="r\\^2 N"):
         richardson([10, 20, 50], [2.0, 1.9, 1.85])
 
 
-def test_phases_on_grid_repeats_a_pattern_on_a_multiple_of_its_grid() -> None:
+def test_phases_on_grid_repeats_a_pattern_but_keeps_the_terminal_rest_one_interval() -> None:
     level = max(load_reference("diff_drive_time").metadata["refinement"]["levels"],
                 key=lambda lv: lv["num_intervals"])
     n, final_time = level["num_intervals"], level["final_time"]
-    pattern = phases_on_grid(level["phases"], final_time, n)
+    pattern = phases_on_grid(level["phases"], final_time, n, n)
     assert pattern.engaged is None and pattern.sliding.shape == (3, n)
     phases = pattern.phases(np.linspace(0.0, final_time, n + 1))
     assert _flat(phases) == pytest.approx(_flat(level["phases"]), abs=1e-12)
-    finer = phases_on_grid(level["phases"], final_time, 4 * n)
-    assert finer.key() == pattern.refined(4).key()
+    # Every contact of this level sticks in the last interval only (the rest at t_f): on a
+    # 4x finer grid, still the last interval only; elsewhere each interval repeated.
+    assert not pattern.sliding[:, -1].any() and pattern.sliding[:, -2].all()
+    finer = phases_on_grid(level["phases"], final_time, 4 * n, n).sliding
+    repeated = pattern.refined(4).sliding
+    np.testing.assert_array_equal(finer[:, :-4], repeated[:, :-4])
+    assert finer[:, -4:-1].all() and not finer[:, -1].any()
 
 
 def test_robot_level_with_the_pattern_fixed_is_the_shipped_optimum_of_its_grid() -> None:
