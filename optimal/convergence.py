@@ -32,7 +32,12 @@ from typing import Any
 import numpy as np
 
 from mdi_envs.stepping.event_driven import EventDrivenIntegrator
-from optimal.mode_search import ModeSolve, improve_modes, solve_with_modes
+from optimal.mode_search import (
+    FIXED_PATTERN_MAX_ITERATIONS,
+    ModeSolve,
+    improve_modes,
+    solve_with_modes,
+)
 from optimal.modes import ModePattern
 from optimal.polish import (
     ATOL,
@@ -99,7 +104,8 @@ def polish_reference(name: str, directory: Path = CONTINUOUS_DIR) -> dict[str, A
 
 
 def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: int,
-                max_rounds: int = 8, warm: tuple[OptimalControlProblem, ModeSolve] | None = None
+                max_rounds: int = 8, warm: tuple[OptimalControlProblem, ModeSolve] | None = None,
+                max_iterations: int = FIXED_PATTERN_MAX_ITERATIONS
                 ) -> tuple[dict[str, Any], OptimalControlProblem, ModeSolve]:
     """The h-discrete optimum on N intervals on one branch of ``name``.
 
@@ -114,6 +120,7 @@ def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: in
         warm: (problem, solve) of a coarser level whose N divides this one: its trajectory
             (``interpolated_guess``) replaces the start's as the initial guess (same pattern);
             the start's guess again if IPOPT does not converge from it.
+        max_iterations: IPOPT's limit in the fixed-pattern solves of the start.
 
     Returns:
         A plain-JSON record: N, cost, t_f, converged, the fixed pattern's cost, whether the
@@ -128,9 +135,11 @@ def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: in
     start = guess.initial_point()
     if warm is not None:
         interpolated_guess(guess, *warm)
-    fixed = solve_with_modes(problem, pattern, initial=guess.initial_point(), transcription=guess)
+    fixed = solve_with_modes(problem, pattern, initial=guess.initial_point(),
+                             max_iterations=max_iterations, transcription=guess)
     if warm is not None and not fixed.success:
-        fixed = solve_with_modes(problem, pattern, initial=start, transcription=guess)
+        fixed = solve_with_modes(problem, pattern, initial=start, max_iterations=max_iterations,
+                                 transcription=guess)
     local = improve_modes(problem, fixed, max_rounds=max_rounds)
     best, moves = local.best, [step.move for step in local.steps]
     phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
@@ -261,7 +270,8 @@ def extrapolated_limit(study: dict[str, Any]) -> dict[str, Any]:
     Returns:
         The finest fit's "value", "order", "coefficient" and "levels"; "previous": the value
         of the fit to the three levels before the finest (NaN with fewer than four levels);
-        "uncertainty": |value - previous|.
+        "uncertainty": |value - previous|. A fit is NaN where its three N are not in a
+        constant ratio or ``richardson`` finds none.
     """
     levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
     if len(levels) < 3:
@@ -269,8 +279,10 @@ def extrapolated_limit(study: dict[str, Any]) -> dict[str, Any]:
                          f"got {len(levels)}")
 
     def fit(chosen: list[dict[str, Any]]) -> dict[str, float]:
-        return richardson([level["num_intervals"] for level in chosen],
-                          [level["cost"] for level in chosen])
+        sizes = [level["num_intervals"] for level in chosen]
+        if sizes[2] * sizes[0] != sizes[1] ** 2:  # not N, r N, r^2 N: no fit
+            return {"value": math.nan, "order": math.nan, "coefficient": math.nan}
+        return richardson(sizes, [level["cost"] for level in chosen])
 
     finest = fit(levels[-3:])
     previous = fit(levels[-4:-1])["value"] if len(levels) >= 4 else math.nan
@@ -349,9 +361,11 @@ def plot_study(study: dict[str, Any], path: Path) -> None:
         axes.loglog(n, abs(distance[-1]) * (n[-1] / n) ** order, "k--", lw=0.8,
                     label=f"order {order:.2f}")
     axes.set_xlabel("N (intervals)")
-    axes.set_ylabel(f"|cost(N) - {target}|" if math.isfinite(limit) else "|change|")
+    axes.set_ylabel(f"|cost(N) - {target}|" if math.isfinite(limit) else
+                    "|cost(N) - cost(previous N)|")
     axes.set_title(f"{study['name']}: {target} {limit:.6f}" if math.isfinite(limit) else
-                   f"{study['name']}: the three finest levels do not converge monotonically",
+                   f"{study['name']}: no extrapolated limit\n(the three finest levels do not "
+                   "converge monotonically)",
                    fontsize=9)
     axes.legend(fontsize=8)
     figure.tight_layout()
@@ -360,7 +374,8 @@ def plot_study(study: dict[str, Any], path: Path) -> None:
 
 
 def run_study(name: str, levels: list[int], directory: Path = CONTINUOUS_DIR,
-              max_rounds: int = 8) -> dict[str, Any]:
+              max_rounds: int = 8, max_iterations: int = FIXED_PATTERN_MAX_ITERATIONS
+              ) -> dict[str, Any]:
     """Solve the missing ``levels`` of ``name``'s study one by one, saving after each.
 
     Levels run coarsest first; a converged level warm-starts the next one solved in the same
@@ -383,7 +398,8 @@ def run_study(name: str, levels: list[int], directory: Path = CONTINUOUS_DIR,
         if str(n) in study["levels"]:
             continue
         level, *solved = solve_level(name, schedule, n, max_rounds,
-                                     warm if warm and n % warm[0].num_intervals == 0 else None)
+                                     warm if warm and n % warm[0].num_intervals == 0 else None,
+                                     max_iterations)
         warm = tuple(solved) if level["converged"] else None
         study["levels"][str(n)] = level
         if record is None and len(study["levels"]) >= 3:
@@ -413,6 +429,8 @@ def main(argv: list[str] | None = None) -> None:
                         help="(re)compute the continuous-time optimum first")
     parser.add_argument("--levels", default="", help="N of the refinement levels, e.g. 30,60")
     parser.add_argument("--rounds", type=int, default=8, help="mode-search rounds per level")
+    parser.add_argument("--iterations", type=int, default=FIXED_PATTERN_MAX_ITERATIONS,
+                        help="IPOPT's limit in a level's first fixed-pattern solve")
     args = parser.parse_args(argv)
     if args.polish:
         record = polish_reference(args.name)
@@ -421,7 +439,7 @@ def main(argv: list[str] | None = None) -> None:
               f"s ({100 * record['relative_difference']:+.3f} %)", flush=True)
     levels = [int(n) for n in args.levels.split(",") if n]
     if levels:
-        run_study(args.name, levels, max_rounds=args.rounds)
+        run_study(args.name, levels, max_rounds=args.rounds, max_iterations=args.iterations)
     path = CONTINUOUS_DIR / f"{args.name}_refinement.json"
     study = json.loads(path.read_text()) if path.exists() else {}
     if "continuous_cost" in study or "extrapolation" in study:  # the table, as markdown
@@ -429,11 +447,12 @@ def main(argv: list[str] | None = None) -> None:
             print("extrapolated limit {value:.7f} (order {order:.3f}, from N = {levels}; "
                   "the three levels before: {previous:.7f}; uncertainty {uncertainty:.1e})"
                   .format(**study["extrapolation"]))
-        print("| N | cost, pattern projected | cost after the mode search (rounds) | "
-              "distance | distance / limit | observed order |\n|---|---|---|---|---|---|")
+        print("| N | cost, pattern projected | cost after the mode search (rounds) | change | "
+              "distance | distance / limit | observed order |\n|---|---|---|---|---|---|---|")
         for row in study_table(study):
             print("| {num_intervals} | {start_cost:.6f} | {cost:.6f} ({max_rounds}) | "
-                  "{distance:.3e} | {relative_distance:.3%} | {order:.2f} |".format(**row))
+                  "{change:.3e} | {distance:.3e} | {relative_distance:.3%} | {order:.2f} |"
+                  .format(**row))
 
 
 if __name__ == "__main__":

@@ -87,6 +87,9 @@ def test_richardson_reports_a_series_that_is_not_monotone() -> None:
     assert all(math.isnan(v) for v in richardson([10, 20, 40], [2.0, 2.1, 2.3]).values())
     with pytest.raises(ValueError, match="r\\^2 N"):
         richardson([10, 20, 50], [2.0, 1.9, 1.85])
+    gapped = extrapolated_limit({"name": "gapped",
+                                 "levels": _levels(lambda n: 1.0 + 1.0 / n, (25, 200, 400))})
+    assert math.isnan(gapped["value"]) and math.isnan(gapped["uncertainty"])
 
 
 def test_phases_on_grid_repeats_a_pattern_but_keeps_the_terminal_rest_one_interval() -> None:
