@@ -443,7 +443,7 @@ def refinement_section(study: dict[str, Any]) -> list[str]:
                 "difference). The distance is to c." if monotone else
                 f"The three finest levels (N = {', '.join(map(str, fit['levels']))}) do not "
                 "change monotonically: no extrapolated limit, no distance.")
-    return [f"## Refinement toward the extrapolated limit: {name}", "",
+    return [f"## Refinement with the pattern fixed: {name}", "",
             command + "solved with the stick-slip phases of the shipped reference's finest "
             "refinement level projected on the grid and fixed "
             "([method](../guide/polish.md#robot-extrapolated-limits)). " + estimate, "",
