@@ -436,11 +436,13 @@ def refinement_section(study: dict[str, Any]) -> list[str]:
                 "distance is to the continuous optimum.", "", table(rows, floatfmt=".6g"), ""]
     fit = study["extrapolation"]
     monotone = math.isfinite(fit["value"])
+    before = (f"the three levels before give {fit['previous']:.7g} (uncertainty "
+              f"{fit['uncertainty']:.2g}, their difference)" if math.isfinite(fit["previous"])
+              else "the three levels before admit no such fit, so there is no uncertainty "
+              "estimate")
     estimate = (f"The limit is **extrapolated, not polished**: cost(N) = c + a h^p through "
                 f"N = {', '.join(map(str, fit['levels']))} gives c = {fit['value']:.7g}, "
-                f"p = {fit['order']:.3f}; the three levels before give "
-                f"{fit['previous']:.7g} (uncertainty {fit['uncertainty']:.2g}, their "
-                "difference). The distance is to c." if monotone else
+                f"p = {fit['order']:.3f}; {before}. The distance is to c." if monotone else
                 f"The three finest levels (N = {', '.join(map(str, fit['levels']))}) do not "
                 "change monotonically: no extrapolated limit, no distance.")
     return [f"## Refinement with the pattern fixed: {name}", "",
