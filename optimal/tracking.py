@@ -105,6 +105,7 @@ from mdi_envs._types import FloatArray
 from optimal.continuation import POLISH_RELAXATION
 from optimal.lqr import TimeVaryingLQR
 from optimal.modes import ModePattern
+from optimal.mpc import ShrinkingHorizonMPC
 from optimal.observations import StateFeedbackPolicy
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
@@ -249,7 +250,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self._reversals = set(np.flatnonzero(np.any(
             torque[1:] * torque[:-1] < 0, axis=1)) + 1) if reference.name in REPLAN else set()
         self._reference_x, self._reference_tau = self._x, self._tau
-        self._full: Any = None
+        self._full: ShrinkingHorizonMPC | None = None
         self._keys = [self._window(k) for k in range(steps + (1 if extension else 0))]
         self._reference_points = [self._reference_point(k) for k in range(len(self._keys))]
         self._reference_multipliers = [self._reference_multiplier(k)
@@ -346,8 +347,6 @@ class TrackingMPC(StateFeedbackPolicy):
         Its plan replaces the reference's rest from interval k - d on, d the steps it arrives
         later (see the module docstring), if it has the reference's mode pattern.
         """
-        from optimal.mpc import ShrinkingHorizonMPC
-
         if self._full is None:
             self._full = ShrinkingHorizonMPC(self.reference, grid="env")
         plan = self._full.replan(k, q, u)
