@@ -34,7 +34,7 @@ def _run_in(tree: Path, scratch: Path, *args: str) -> str:
             (harness / package).symlink_to(tree / package)
         (harness / "benchmarks").symlink_to(ROOT / "benchmarks")
     process = fresh_python("-m", f"benchmarks.{args[0]}", *args[1:], cwd=harness,
-                           PYTHONPATH=str(harness))
+                           PYTHONPATH=harness)
     if process.returncode != 0:
         raise RuntimeError(f"benchmarks.{args[0]} on {tree} failed: "
                            f"{process.stderr.strip().splitlines()[-1:]}")
@@ -66,8 +66,8 @@ def run_once(tree: Path, scratch: Path, log: Progress) -> dict[str, tuple[float,
     return found
 
 
-def run(before: Path, rounds: int, output: Path) -> str:
-    """Alternate the trees ``rounds`` times, write the JSON and PNG, return the table."""
+def run(before: Path, rounds: int, output: Path) -> dict[str, Any]:
+    """Alternate the trees ``rounds`` times, write the JSON and PNG; returns the record."""
     log = Progress()
     samples: dict[str, dict[str, list[float]]] = {}  # target -> label -> values
     units: dict[str, str] = {}
@@ -92,7 +92,7 @@ def run(before: Path, rounds: int, output: Path) -> str:
     output.mkdir(parents=True, exist_ok=True)
     (output / "before_after.json").write_text(json.dumps(record, indent=2))
     _plot(rows, output / "before_after.png")
-    return report.flat_table(rows, ["target", "unit", "before", "after", "slowdown", "ok"])
+    return record
 
 
 def _plot(rows: list[dict[str, Any]], path: Path) -> None:
@@ -116,8 +116,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                      quick=False)
     if not (args.before / "mdi_envs" / "__init__.py").exists():
         raise SystemExit(f"--before {args.before}: no mdi_envs package there")
-    print(run(args.before.resolve(), args.rounds, args.output))
-    record = json.loads((args.output / "before_after.json").read_text())
+    record = run(args.before.resolve(), args.rounds, args.output)
+    print(report.flat_table(record["rows"],
+                            ["target", "unit", "before", "after", "slowdown", "ok"]))
     return 0 if all(row["ok"] for row in record["rows"]) else 1
 
 

@@ -22,12 +22,11 @@ from benchmarks.engine_mujoco import MujocoArm, import_mujoco
 from benchmarks.engine_scenes import (
     MANIPULATOR_Q,
     TIME_STEP,
-    BatchedCall,
+    Copies,
     ModelCase,
     batch_arrays,
     calibrate_substeps,
     model_cases,
-    stepper,
 )
 from benchmarks.report import bars, format_us, log_lines, plt, save_figure, summary
 from benchmarks.timing import Log, TimingPlan
@@ -110,12 +109,14 @@ def compile_stepper(case: ModelCase, log: Log, records: list[dict[str, Any]],
 
     These first calls compile (or load) the kernels; ``step`` is timed for the default only.
     """
-    label = "default shortcuts" if shortcuts is None else shortcuts_text(shortcuts)
+    default, shortcuts = shortcuts is None, shortcuts or StepShortcuts()
+    label = ", ".join(f"{k}={v}" for k, v in shortcuts._asdict().items()
+                      if getattr(StepShortcuts(), k) != v) or "default shortcuts"
     log(f"compiling {case.label} ({label}) ...")
-    st = stepper(case, shortcuts)
+    st = MoreauJeanStepper(case.model, time_step=TIME_STEP, shortcuts=shortcuts)
     arrays = case.scenes[0].arrays()
-    step_s = None if shortcuts is not None else timing.seconds(lambda: st.step(*arrays))
-    batch_s = timing.seconds(lambda: BatchedCall(st, batch_arrays(case, 2), 1)())
+    step_s = timing.timed_call(lambda: st.step(*arrays))[1] if default else None
+    batch_s = timing.timed_call(lambda: Copies(st, *batch_arrays(case, 2), warm_start=True)())[1]
     records.append({"stepper": f"{case.label} ({label})", "step_s": step_s,
                     "step_batch_s": batch_s})
     log(f"  first step_batch {batch_s:.1f} s"
@@ -168,10 +169,11 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
 
 
 def _batched_entry(st: MoreauJeanStepper, initial: tuple, target_s: float,
-                   min_substeps: int = 1) -> BatchedCall:
-    """A ``BatchedCall`` of at least ``min_substeps`` substeps, lasting about ``target_s``+."""
-    call = BatchedCall(st, initial)
-    return call.with_substeps(max(min_substeps, calibrate_substeps(call.with_substeps, target_s)))
+                   min_substeps: int = 1) -> tuple[Copies, int]:
+    """A warm-started ``Copies`` call of about ``target_s``+, and its (>= min_substeps) substeps."""
+    call = Copies(st, *initial, warm_start=True)
+    call.num_substeps = max(min_substeps, calibrate_substeps(call.with_substeps, target_s))
+    return call, call.num_substeps
 
 
 def _mujoco_entry(arm: MujocoArm, num_copies: int, target_s: float,
@@ -199,18 +201,14 @@ def _per_copy_rows(entries: dict[str, tuple[Callable[[], Any], int]], n: int,
             for key, value in timed.items()]
 
 
-def _entry(call: BatchedCall) -> tuple[BatchedCall, int]:
-    return call, call.num_substeps
-
-
 def scene_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper],
                 arm: MujocoArm | None, config: EngineConfig, log: Log
                 ) -> list[dict[str, Any]]:
     """In-kernel µs per step of each scene: ``step_batch`` with every copy in that scene."""
     n = config.scene_copies
-    entries = {f"{case.label}|{scene.name}": _entry(_batched_entry(
+    entries = {f"{case.label}|{scene.name}": _batched_entry(
         steppers[case.label], batch_arrays(case, n, [scene]), config.call_s,
-        config.scene_min_substeps)) for case in cases for scene in case.scenes}
+        config.scene_min_substeps) for case in cases for scene in case.scenes}
     for scene in MUJOCO_SCENES if arm is not None else ():
         entries[f"mujoco|{scene}"] = _mujoco_entry(arm, n, config.call_s, (scene,))
     log(f"in-kernel per scene (N = {n}): {len(entries)} callables, interleaved ...")
@@ -223,8 +221,8 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
     """µs per copy-step of each model's mix (and MuJoCo's) for every N, interleaved per N."""
     rows = []
     for n in config.copies:
-        entries = {case.label: _entry(_batched_entry(steppers[case.label], batch_arrays(case, n),
-                                                     config.call_s)) for case in cases}
+        entries = {case.label: _batched_entry(steppers[case.label], batch_arrays(case, n),
+                                              config.call_s) for case in cases}
         if arm is not None:
             entries["mujoco"] = _mujoco_entry(arm, n, config.call_s)
         measured = _per_copy_rows(entries, n, config.batch_plan, ("model",))
@@ -241,8 +239,9 @@ def substeps_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
     if not config.substep_grid:
         return []
     n = config.scene_copies
-    entries = {f"{case.label}|{k}": (BatchedCall(steppers[case.label], batch_arrays(case, n), k),
-                                     k) for case in cases for k in config.substep_grid}
+    entries = {f"{case.label}|{k}": (Copies(steppers[case.label], *batch_arrays(case, n), k,
+                                            warm_start=True), k)
+               for case in cases for k in config.substep_grid}
     log(f"substeps per call (N = {n}): {len(entries)} callables, interleaved ...")
     return _per_copy_rows(entries, n, config.substep_plan, ("model",))
 
@@ -260,20 +259,21 @@ def shortcut_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper
         if case is None:
             continue
         on_arrays = batch_arrays(case, n, [case.scene(sc.scene)])
-        on = _batched_entry(steppers[case.label], on_arrays, config.call_s,
-                            config.scene_min_substeps)
+        on, _ = _batched_entry(steppers[case.label], on_arrays, config.call_s,
+                               config.scene_min_substeps)
         difference: float | None = None
         if isinstance(sc.off, StepShortcuts):
             key = (case.label, sc.off)
             if key not in variants:
                 variants[key] = compile_stepper(case, log, compile_records, sc.off)
-            off = BatchedCall(variants[key], on_arrays, on.num_substeps)
+            off = Copies(variants[key], *on_arrays, on.num_substeps, warm_start=True)
             on()  # both from the same initial states: the largest |state difference|
             off()
             difference = float(max(np.abs(on.q - off.q).max(), np.abs(on.u - off.u).max()))
         else:
-            off = _batched_entry(steppers[case.label], batch_arrays(case, n, [case.scene(sc.off)]),
-                                 config.call_s, config.scene_min_substeps)
+            off, _ = _batched_entry(steppers[case.label],
+                                    batch_arrays(case, n, [case.scene(sc.off)]), config.call_s,
+                                    config.scene_min_substeps)
         timed = timing.time_interleaved({"on": on, "off": off}, config.shortcut_plan)
         row = {"shortcut": sc.shortcut, "model": sc.model, "scene": sc.scene,
                "off_scene": sc.off if isinstance(sc.off, str) else sc.scene,
@@ -348,7 +348,10 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
         timing.checkpoint(record, "compile", clock)
         record["compile"] = []
         steppers = {case.label: compile_stepper(case, log, record["compile"]) for case in cases}
-        record["models"] = [case_record(c) for c in cases]
+        record["models"] = [{"label": c.label, "model": c.model.__name__,
+                             "mix": [s.name for s in c.mix_scenes],
+                             "scenes": report.json_safe([asdict(s) for s in c.scenes])}
+                            for c in cases]
         if arm is not None and "manipulator" in steppers:
             st, ours = steppers["manipulator"], np.empty((2, 2))
             compile_equations(st.model).mass(np.array(MANIPULATOR_Q), st._values, ours)
@@ -369,20 +372,6 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
                          output / "engine_single_step.png")
         plot_shortcuts(record["shortcuts"], output / "engine_shortcuts.png")
     return summary(record, ("numpy", "numba", "mujoco"))
-
-
-def shortcuts_text(shortcuts: Any) -> str:
-    """The fields of a ``StepShortcuts`` that differ from the defaults, as ``a=b`` text."""
-    defaults = type(shortcuts)()
-    changed = [f"{k}={v}" for k, v in shortcuts._asdict().items() if getattr(defaults, k) != v]
-    return ", ".join(changed) or "default shortcuts"
-
-
-def case_record(case: Any) -> dict[str, Any]:
-    """A model case (model, scenes, mix) as JSON-ready data (an ideal brake's bound "inf")."""
-    return {"label": case.label, "model": case.model.__name__,
-            "mix": [s.name for s in case.mix_scenes],
-            "scenes": report.json_safe([asdict(s) for s in case.scenes])}
 
 
 def plot_batched(batched: Sequence[dict[str, Any]], substeps: Sequence[dict[str, Any]],

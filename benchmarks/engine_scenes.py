@@ -1,4 +1,4 @@
-"""Scenes of the engine benchmark: the models, their representative states and the steppers.
+"""Scenes of the engine benchmark: the models, their representative states, their batched calls.
 
 Copy i of N gets scene ``i mod k`` of its model's k scenes; each timed call restarts from them.
 """
@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 
 from mdi_envs import mechanics
-from mdi_envs.stepping import MoreauJeanStepper, StepShortcuts
+from mdi_envs.stepping import MoreauJeanStepper
+from mdi_envs.stepping._kernel import INFO_STATUS
 
 TIME_STEP = 1e-3  # [s] of every stepper and of MuJoCo
 TRESCA_BOUND = 0.5  # [N m] the Tresca scenes' brake bound (MuJoCo: frictionloss)
@@ -121,36 +122,75 @@ def batch_arrays(case: ModelCase, num_copies: int, scenes: Sequence[Scene] | Non
     return q, u, tau, brake.reshape(num_copies, case.model.NUM_BRAKES)
 
 
-@dataclass
-class BatchedCall:
-    """One ``step_batch`` call on N copies (no input checks), restarted from the same states.
+class Copies:
+    """N copies of one stepper's state with preallocated ``step_batch`` arguments.
 
-    Spatial contacts' warm-start impulses start as those of one step from the states.
+    ``reset`` goes back to the initial states, and the warm-start impulses of spatial contacts
+    to zero or (``warm_start``) to those of one step from the initial states. A call resets and
+    advances ``num_substeps`` steps.
     """
 
-    stepper: MoreauJeanStepper
-    initial: tuple[np.ndarray, ...]
-    num_substeps: int = 1
+    def __init__(self, stepper: MoreauJeanStepper, q0: np.ndarray | None = None,
+                 u0: np.ndarray | None = None, tau: np.ndarray | None = None,
+                 brake: np.ndarray | None = None, num_substeps: int = 1,
+                 warm_start: bool = False) -> None:
+        """N copies from states q0, u0 (N, n) [SI], inputs tau (N, m), brake bounds (N, k).
 
-    def __post_init__(self) -> None:
-        self.q = self.initial[0].copy()
-        self.u = self.initial[1].copy()
-        self.initial_impulses, info = self.stepper.step_batch(
-            self.q, self.u, self.initial[2], self.initial[3])
-        self.out = (self.initial_impulses.copy(), info)
+        Default: one copy at rest at the origin, zero inputs and bounds.
+        """
+        self.stepper, self.num_substeps = stepper, num_substeps
+        self.q0 = np.zeros((1, stepper.num_dofs)) if q0 is None else np.array(q0, dtype=float)
+        self.u0 = np.zeros_like(self.q0) if u0 is None else np.array(u0, dtype=float)
+        n = self.q0.shape[0]
+        self.q, self.u = self.q0.copy(), self.u0.copy()
+        self.tau = np.zeros((n, stepper.num_inputs)) if tau is None else np.array(tau, dtype=float)
+        self.brake = np.zeros((n, stepper.num_brakes)) if brake is None else np.array(brake)
+        self.impulses0 = np.zeros((n, stepper.num_impulses))
+        if warm_start:  # those of one step from (copies of) the initial states
+            q, u = self.q0.copy(), self.u0.copy()
+            self.impulses0 = stepper.step_batch(q, u, self.tau, self.brake)[0]
+        self.out = (self.impulses0.copy(), np.empty((n, stepper.info_size)))
 
-    def with_substeps(self, num_substeps: int) -> BatchedCall:
+    def reset(self) -> None:
+        """Back to the initial states and warm-start impulses."""
+        self.q[:] = self.q0
+        self.u[:] = self.u0
+        self.out[0][:] = self.impulses0
+
+    def command(self, tau: Sequence[float], brake: Sequence[float] = ()) -> None:
+        """Set every copy's inputs (m,) and brake bounds (k,) (inf: ideal brake)."""
+        self.tau[:] = tau
+        if self.brake.shape[1]:
+            self.brake[:] = brake
+
+    def advance(self, steps: int) -> None:
+        """``steps`` steps in one compiled call (no input checks)."""
+        self.stepper.step_batch(self.q, self.u, self.tau, self.brake, steps, check_inputs=False,
+                                out=self.out)
+
+    def state(self, copy: int = 0) -> np.ndarray:
+        """(q, u) of one copy, concatenated (2n,)."""
+        return np.concatenate([self.q[copy], self.u[copy]])
+
+    def run(self, phases: Sequence[tuple[int, Sequence[float], Sequence[float]]]) -> np.ndarray:
+        """From the initial states through (steps, inputs, brake bounds) phases, one call each."""
+        self.reset()
+        self.worst_status = 0
+        for steps, tau, brake in phases:
+            self.command(tau, brake)
+            self.advance(steps)
+            self.worst_status = max(self.worst_status, int(self.out[1][0, INFO_STATUS]))
+        return self.state()
+
+    def with_substeps(self, num_substeps: int) -> Copies:
         """This call, set to ``num_substeps`` substeps."""
         self.num_substeps = num_substeps
         return self
 
     def __call__(self) -> None:
         """Restart from the initial states and advance ``num_substeps`` steps."""
-        np.copyto(self.q, self.initial[0])
-        np.copyto(self.u, self.initial[1])
-        np.copyto(self.out[0], self.initial_impulses)
-        self.stepper.step_batch(self.q, self.u, self.initial[2], self.initial[3],
-                                self.num_substeps, check_inputs=False, out=self.out)
+        self.reset()
+        self.advance(self.num_substeps)
 
 
 def calibrate_substeps(make: Callable[[int], Callable[[], Any]], target_s: float,
@@ -168,9 +208,3 @@ def calibrate_substeps(make: Callable[[int], Callable[[], Any]], target_s: float
         substeps = min(max_substeps,
                        substeps * max(2, min(1000, int(0.3 * target_s / max(seconds, 1e-7)))))
     return int(min(max_substeps, max(1, np.ceil(substeps * target_s / max(seconds, 1e-9)))))
-
-
-def stepper(case: ModelCase, shortcuts: StepShortcuts | None = None) -> MoreauJeanStepper:
-    """The stepper of ``case`` with ``shortcuts`` (default all on; compiles on first use)."""
-    return MoreauJeanStepper(case.model, time_step=TIME_STEP,
-                             shortcuts=StepShortcuts() if shortcuts is None else shortcuts)

@@ -8,10 +8,10 @@ against N beside Acrobot in ``"sync"`` mode. The process is pinned to one CPU (`
 
 from __future__ import annotations
 
-import math
+import itertools
 import os
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -94,22 +94,15 @@ class StepLoop:
 
     def __init__(self, env: Any, actions: list[Any], max_steps: int | None = None,
                  steps_per_call: int = STEPS_PER_CALL) -> None:
-        self.env = env
-        self.max_steps = max_steps
-        self.steps_per_call = steps_per_call
-        cycle = len(actions) // math.gcd(len(actions), steps_per_call)
-        self.chunks = [[actions[(c * steps_per_call + j) % len(actions)]
-                        for j in range(steps_per_call)] for c in range(cycle)]
-        self.chunk = 0
-        self.episode_steps = 0
-        self.steps = 0
-        self.episodes = 0
+        self.env, self.max_steps, self.steps_per_call = env, max_steps, steps_per_call
+        self.actions = itertools.cycle(actions)
+        self.episode_steps = self.steps = self.episodes = 0
 
     def __call__(self) -> None:
         """Step ``steps_per_call`` times (and reset whenever an episode ends)."""
         env, max_steps = self.env, self.max_steps
         episode_steps = self.episode_steps
-        for action in self.chunks[self.chunk]:
+        for action in itertools.islice(self.actions, self.steps_per_call):
             _, _, terminated, truncated, _ = env.step(action)
             episode_steps += 1
             if terminated or truncated or episode_steps == max_steps:
@@ -118,21 +111,6 @@ class StepLoop:
                 episode_steps = 0
         self.episode_steps = episode_steps
         self.steps += self.steps_per_call
-        self.chunk = (self.chunk + 1) % len(self.chunks)
-
-
-@dataclass
-class VectorLoop:
-    """One vector ``step`` per call with the next pre-sampled action batch (autoreset inside)."""
-
-    env: Any
-    actions: list[Any]
-    index: int = 0
-
-    def __call__(self) -> None:
-        """Step every copy once."""
-        self.env.step(self.actions[self.index])
-        self.index = (self.index + 1) % len(self.actions)
 
 
 def _error_text(error: BaseException) -> str:
@@ -143,9 +121,9 @@ def _make_single(env_id: str, ours: bool, seed: int, samples: int
                  ) -> tuple[dict[str, Any], list[Any]]:
     """Make the env twice (timed ``gym.make`` and unwrapped) and time the first calls."""
     env, make_s = timing.timed_call(lambda: gym.make(env_id))
-    reset_s = timing.seconds(lambda: env.reset(seed=seed))
+    reset_s = timing.timed_call(lambda: env.reset(seed=seed))[1]
     actions = _sample_actions(env.action_space, samples, seed)
-    first_step_s = timing.seconds(lambda: env.step(actions[0]))
+    first_step_s = timing.timed_call(lambda: env.step(actions[0]))[1]
     env.reset(seed=seed)
     bare = gym.make(env_id).unwrapped
     bare.reset(seed=seed)
@@ -162,7 +140,7 @@ def _make_single(env_id: str, ours: bool, seed: int, samples: int
 
 def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsConfig,
                      log: Log) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """``env.step`` through ``gym.make`` and unwrapped, for ours and the peers, interleaved."""
+    """``env.step`` through ``gym.make`` and unwrapped, interleaved; ours with ratios to peers."""
     records, unavailable = [], []
     loops: dict[str, StepLoop] = {}
     for env_id in (*env_ids, *peers):
@@ -189,33 +167,34 @@ def single_env_study(env_ids: Sequence[str], peers: Sequence[str], config: EnvsC
                 "episodes_ended": loop.episodes}
             loop.env.close()
         record["per_physics_step_us"] = record["gym.make"]["median_us"] / record["frame_skip"]
-    _add_ratios(records)
-    return records, unavailable
-
-
-def _add_ratios(records: list[dict[str, Any]]) -> None:
-    """Peer time / our time for each of ours and each peer (medians and fastest rounds)."""
     peers = [r for r in records if not r["ours"]]
-    for ours in (r for r in records if r["ours"]):
+    for ours in (r for r in records if r["ours"]):  # peer time / ours, medians and fastest
         ours["ratios"] = {peer["env_id"]: {
             "ratio_median": peer["gym.make"]["median_us"] / ours["gym.make"]["median_us"],
             "ratio_fastest": peer["gym.make"]["min_us"] / ours["gym.make"]["min_us"],
             "ratio_median_unwrapped": (peer["unwrapped"]["median_us"]
                                        / ours["unwrapped"]["median_us"])} for peer in peers}
+    return records, unavailable
 
 
 def _vector_entry(env_id: str, mode: str, num_envs: int, config: EnvsConfig
-                  ) -> tuple[VectorLoop, dict[str, Any]]:
-    """A reset vector env with pre-sampled action batches, and its description."""
+                  ) -> tuple[Any, Callable[[], None], dict[str, Any]]:
+    """A reset vector env, a call stepping every copy once, and its description.
+
+    Each call steps with the next pre-sampled action batch (the env resets copies itself).
+    """
     start = time.perf_counter()
     env = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode=mode)
     env.reset(seed=config.seed)
     samples = max(2, min(config.action_samples, 16))
-    actions = _sample_actions(env.action_space, samples, config.seed)
-    loop = VectorLoop(env, actions)
+    batches = itertools.cycle(_sample_actions(env.action_space, samples, config.seed))
+
+    def loop() -> None:
+        env.step(next(batches))
+
     loop()
     setup_s = time.perf_counter() - start
-    return loop, {"env_id": env_id, "mode": mode, "num_envs": num_envs,
+    return env, loop, {"env_id": env_id, "mode": mode, "num_envs": num_envs,
                   "frame_skip": frame_skip(env), "setup_s": setup_s,
                   "action_batches": samples}
 
@@ -230,14 +209,15 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Log
     if config.sync_peer is not None:
         entries.append((config.sync_peer, "sync"))
     for n in config.copies:
-        loops: dict[str, VectorLoop] = {}
+        envs: dict[str, Any] = {}
+        loops: dict[str, Callable[[], None]] = {}
         meta: dict[str, dict[str, Any]] = {}
         for env_id, mode in entries:
             key = f"{env_id}|{mode}"
             if key in failed or (mode == "sync" and n > config.sync_max_copies):
                 continue
             try:
-                loops[key], meta[key] = _vector_entry(env_id, mode, n, config)
+                envs[key], loops[key], meta[key] = _vector_entry(env_id, mode, n, config)
             except Exception as error:  # noqa: BLE001  (recorded, the run continues)
                 failed.add(key)
                 unavailable.append({"env_id": env_id, "mode": mode, "num_envs": n,
@@ -254,7 +234,7 @@ def vector_study(env_ids: Sequence[str], config: EnvsConfig, log: Log
                 **{f"env_steps_per_s{k}": n / times[f"{stat}_s"] for k, stat in rates},
                 "per_env_step_us": times["median_s"] / n * 1e6,
                 **{f"physics_steps_per_s{k}": n / times[f"{stat}_s"] * skip for k, stat in rates}})
-            loops[key].env.close()
+            envs[key].close()
         rows += measured
         log(f"vector N = {n}: " + ", ".join(
             f"{short_name(r['env_id'])} ({r['mode']}) {r['env_steps_per_s']:.3g} env-steps/s"

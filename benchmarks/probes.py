@@ -21,19 +21,18 @@ FLOOR = "numba-floor"  # The pseudo id of the numba floor case (see the module d
 def first_call() -> None:
     """Print the import and first-call report of the LCP entries as JSON."""
     import importlib
+    from functools import partial
 
-    from benchmarks.timing import seconds
+    from benchmarks.timing import timed_call
 
-    import_times = {
-        "mdi_envs.solvers.lcp": seconds(lambda: importlib.import_module("mdi_envs.solvers.lcp")),
-        "quantecon.optimize": seconds(lambda: importlib.import_module("quantecon.optimize")),
-    }
+    import_times = {name: timed_call(partial(importlib.import_module, name))[1]
+                    for name in ("mdi_envs.solvers.lcp", "quantecon.optimize")}
     from benchmarks import problems as entries
 
     problem = entries.random_problem("spd", 5, 0)
     probes = [entries.KERNEL, *map(entries.driver_entry, entries.LCP_METHODS), entries.QUANTECON]
-    first = {e.name: seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
-    second = {e.name: seconds(lambda e=e: e.solve(problem.M, problem.q)) for e in probes}
+    first, second = [{e.name: timed_call(partial(e.solve, problem.M, problem.q))[1]
+                      for e in probes} for _ in range(2)]
     print(json.dumps({"import_s": import_times, "first_call_s": first, "second_call_s": second}))
 
 

@@ -7,6 +7,8 @@ the driver ``solve_lcp`` and its compiled entry ``lemke_solve``, interleaved wit
 
 from __future__ import annotations
 
+import json
+import tempfile
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -51,21 +53,19 @@ QUICK = BenchConfig(
 
 
 def measure_first_calls(config: BenchConfig, log: Log) -> dict[str, Any]:
-    """First-call (compile or cache-load) times, each from a fresh interpreter."""
+    """First-call (compile or cache-load) times, each from a fresh interpreter (``probes``)."""
     results = {}
     for label, cold in (("warm_cache", False), ("cold_cache", True))[:1 + config.cold_compile]:
         log(f"first-call probe ({label}) in a fresh interpreter ...")
-        results[label] = timing.probe_first_calls(cold)
+        with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache_dir:
+            cache = cache_dir if cold else None  # numba's cache, and the package's own
+            process = timing.fresh_python("-m", "benchmarks.probes", "first-call",
+                                          NUMBA_CACHE_DIR=cache, MDI_ENVS_CACHE_DIR=cache)
+        results[label] = (json.loads(process.stdout) if process.returncode == 0
+                          else {"error": process.stderr.strip().splitlines()[-1:]})
         calls = results[label].get("first_call_s", {})
         log("  " + ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in calls.items()))
     return results
-
-
-def warm_up(all_entries: Sequence[E.Entry]) -> None:
-    """Call every entry once in this process so no timed call includes a compile or cache load."""
-    problem = E.random_problem("spd", 5, 0)
-    for entry in all_entries:
-        entry.solve(problem.M, problem.q)
 
 
 def time_problem(problem: E.Problem, chosen: Sequence[E.Entry], plan: TimingPlan) -> dict[str, Any]:
@@ -81,22 +81,17 @@ def size_study(config: BenchConfig, log: Log) -> list[dict[str, Any]]:
     """Every method on every (family, n, instance) of the grid; one record per entry."""
     records = []
     for family in E.FAMILIES:
-        for n in config.sizes:
+        for n in config.sizes:  # the methods applicable at n, and QuantEcon's Lemke
+            entries = [E.driver_entry(m) for m in E.LCP_METHODS
+                       if m != "enumerative" or n <= E.ENUMERATIVE_MAX_N] + [E.QUANTECON]
             latest = [{"family": family, "n": n, "instance": i, "entry": name, **measured}
                       for i in range(config.instances) for name, measured in time_problem(
-                          E.random_problem(family, n, i), size_study_entries(n),
-                          config.size_plan).items()]
+                          E.random_problem(family, n, i), entries, config.size_plan).items()]
             records += latest
             log(f"size study {family} n={n}: " + ", ".join(
                 f"{r['entry']} {report.format_us(r['time_median_s'])} µs"
                 for r in aggregate_size_study(latest)))
     return records
-
-
-def size_study_entries(n: int) -> list[E.Entry]:
-    """The driver methods applicable at size n, plus QuantEcon's Lemke for reference."""
-    return [E.driver_entry(m) for m in E.LCP_METHODS
-            if m != "enumerative" or n <= E.ENUMERATIVE_MAX_N] + [E.QUANTECON]
 
 
 def comparison_problems(config: BenchConfig, log: Log) -> list[E.Problem]:
@@ -140,7 +135,9 @@ def run(config: BenchConfig, output: Path, quick: bool) -> str:
     """Run the whole benchmark, write the outputs and return its summary (Markdown)."""
     with report.study("solvers", output, {"quick": quick, **asdict(config)}) as (record, log, _):
         record["first_call"] = measure_first_calls(config, log)
-        warm_up([E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)])
+        problem = E.random_problem("spd", 5, 0)  # every entry once: no timed compile or load
+        for entry in [E.KERNEL, E.QUANTECON, *(E.driver_entry(m) for m in E.LCP_METHODS)]:
+            entry.solve(problem.M, problem.q)
         record["fixed_cost"] = [
             {k: v for k, v in row.items() if not k.startswith(("family", "ratio"))}
             for row in compare_lemke(FIXED_COST_PROBLEMS, config.peer_plan, log)]

@@ -31,18 +31,15 @@ QUICK_IDS = ("mdi_envs/BlockableManipulator-v1", "Acrobot-v1")
 TARGET_RATIO = 2.0  # Warm start-up target: within this factor of Acrobot-v1's, entry by entry.
 
 
-def _paths(cache: Path | None, python_path: Path | None) -> dict[str, str | None]:
-    """The kernel cache and PYTHONPATH of a fresh interpreter (None: as in this one)."""
-    return {"MDI_ENVS_CACHE_DIR": None if cache is None else str(cache),
-            "PYTHONPATH": None if python_path is None else str(python_path)}
-
-
 def time_to_first_step(entry: str, env_id: str, cache: Path | None,
                        python_path: Path | None = None) -> dict[str, Any]:
-    """Seconds from starting a fresh interpreter to its first ``step`` returned, and phases."""
+    """Seconds from starting a fresh interpreter to its first ``step`` returned, and phases.
+
+    ``cache``: the kernel cache, ``python_path``: PYTHONPATH (None: as in this interpreter).
+    """
     started = time.time()
     process = fresh_python("-m", "benchmarks.probes", "startup", entry, env_id,
-                           **_paths(cache, python_path))
+                           MDI_ENVS_CACHE_DIR=cache, PYTHONPATH=python_path)
     lines = [line for line in process.stdout.splitlines() if line.startswith("{")]
     if process.returncode != 0 or not lines:
         return {"error": (process.stderr.strip().splitlines() or ["no output"])[-1]}
@@ -54,7 +51,8 @@ def compile_all(cache: Path | None, python_path: Path | None = None) -> dict[str
     """Wall seconds of ``mdi-envs compile all`` in a fresh interpreter, and its exit code."""
     started = time.perf_counter()
     process = fresh_python("-c", "import sys; from mdi_envs.cli import main; "
-                           "sys.exit(main(['compile', 'all']))", **_paths(cache, python_path))
+                           "sys.exit(main(['compile', 'all']))", MDI_ENVS_CACHE_DIR=cache,
+                           PYTHONPATH=python_path)
     return {"seconds": time.perf_counter() - started, "returncode": process.returncode,
             "output": process.stdout.strip().splitlines()[-6:]}
 
@@ -67,8 +65,8 @@ def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def run(quick: bool, output: Path, python_path: Path | None = None,
-        repeats: int = 5) -> str:
-    """Run the study, write ``startup.json`` / ``startup.png``, return the targets (Markdown)."""
+        repeats: int = 5) -> dict[str, Any]:
+    """Run the study, write ``startup.json`` and ``startup.png``; returns the record."""
     from mdi_envs import ENV_IDS
 
     log = Progress()
@@ -107,7 +105,7 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
     output.mkdir(parents=True, exist_ok=True)
     (output / "startup.json").write_text(json.dumps(record, indent=2))
     _plot(record, ids, entries, output / "startup.png")
-    return report.targets_table(record["targets"]) if record["targets"] else "no targets (quick)"
+    return record
 
 
 def _ratios(warm: dict[str, Any], entries: Sequence[str]) -> dict[str, float]:
@@ -163,8 +161,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = arguments(__doc__, argv, ("--python-path", {"type": Path, "help": "probe the package "
                                                        "in this folder (PYTHONPATH)"}),
                      ("--repeats", {"type": int, "default": 5, "help": "warm repetitions"}))
-    print(run(args.quick, args.output, args.python_path, args.repeats))
-    record = json.loads((args.output / "startup.json").read_text())
+    record = run(args.quick, args.output, args.python_path, args.repeats)
+    print(report.targets_table(record["targets"]) if record["targets"] else "no targets (quick)")
     failed = [key for key, summary in record["warm"].items() if "errors" in summary]
     return 1 if failed or record["compile_all"]["returncode"] != 0 else 0
 

@@ -9,13 +9,11 @@ from __future__ import annotations
 import argparse
 import contextlib
 import datetime as dt
-import json
 import math
 import os
 import platform
 import subprocess
 import sys
-import tempfile
 import time
 import timeit
 from collections.abc import Callable, Mapping, Sequence
@@ -94,23 +92,12 @@ ROOT = Path(__file__).resolve().parents[1]
 """The repository's root, where ``python -m benchmarks.NAME`` runs."""
 
 
-def fresh_python(*args: str, cwd: Path = ROOT, **env: str | None
+def fresh_python(*args: str, cwd: Path = ROOT, **env: str | Path | None
                  ) -> subprocess.CompletedProcess[str]:  # fmt: skip
-    """``python ARGS`` in a fresh interpreter in ``cwd``, ``env`` (but None) over this one's."""
-    environment = {**os.environ, **{key: value for key, value in env.items() if value is not None}}
+    """``python ARGS`` in a fresh interpreter in ``cwd``, ``env`` (but None or "") over ours."""
+    environment = {**os.environ, **{key: str(value) for key, value in env.items() if value}}
     return subprocess.run([sys.executable, *args], cwd=cwd, env=environment, capture_output=True,
                           text=True, check=False)
-
-
-def probe_first_calls(cold: bool) -> dict[str, Any]:
-    """Run ``benchmarks.probes first-call`` in a fresh interpreter and return its JSON report."""
-    with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache_dir:
-        cache = cache_dir if cold else None  # numba's cache, and the package's own
-        process = fresh_python("-m", "benchmarks.probes", "first-call", NUMBA_CACHE_DIR=cache,
-                               MDI_ENVS_CACHE_DIR=cache)
-    if process.returncode != 0:
-        return {"error": process.stderr.strip().splitlines()[-1:]}
-    return json.loads(process.stdout)
 
 
 def _cpu_model() -> str:
@@ -152,11 +139,6 @@ def speed_probe(samples: int = 200, number: int = 5000) -> dict[str, float]:
     fastest = min(times)
     return {"fastest_us": fastest, "median_us": float(np.median(times)),
             "slow_fraction": sum(t > 1.5 * fastest for t in times) / samples}
-
-
-def seconds(action: Callable[[], Any]) -> float:
-    """Wall-clock seconds of one call of ``action()``."""
-    return timed_call(action)[1]
 
 
 def _version(name: str) -> str | None:

@@ -21,6 +21,7 @@ import numpy as np
 
 from benchmarks import engine_mujoco as mj
 from benchmarks import report, timing
+from benchmarks.engine_scenes import Copies
 from benchmarks.report import format_number, log_lines, plt, save_figure, summary
 from benchmarks.timing import Log, TimingPlan
 from mdi_envs import stepping
@@ -28,7 +29,6 @@ from mdi_envs.mechanics import models
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
 from mdi_envs.mechanics.models.sliding_block import SlidingBlockParameters
 from mdi_envs.solvers.status import SolverStatus
-from mdi_envs.stepping._kernel import INFO_STATUS
 from mdi_envs.stepping.event_driven import EVENT_APEX, EVENT_IMPACT, Trajectory
 
 METHODS = {"enumerative": stepping.StepShortcuts(),
@@ -146,59 +146,12 @@ class Context:
         key = (model.__name__, variant)
         if key not in self._compiled:
             self.log(f"compiling {model.__name__} step_batch ({variant}) ...")
-            seconds = timing.seconds(lambda: Copies(st).advance(1))
+            seconds = timing.timed_call(lambda: Copies(st).advance(1))[1]
             self.compile.append({"model": model.__name__, "method": variant,
                                  "first_step_batch_s": seconds})
             self.log(f"  {seconds:.1f} s")
             self._compiled.add(key)
         return st
-
-
-class Copies:
-    """N copies of one stepper's state with preallocated ``step_batch`` arguments."""
-
-    def __init__(self, stepper: stepping.MoreauJeanStepper, q0: np.ndarray | None = None,
-                 u0: np.ndarray | None = None) -> None:
-        """N copies from states q0, u0 (N, n) [SI] (default: one copy at rest at the origin)."""
-        self.stepper = stepper
-        self.q0 = np.zeros((1, stepper.num_dofs)) if q0 is None else np.array(q0, dtype=float)
-        self.u0 = np.zeros_like(self.q0) if u0 is None else np.array(u0, dtype=float)
-        n = self.q0.shape[0]
-        self.q, self.u = self.q0.copy(), self.u0.copy()
-        self.tau = np.zeros((n, stepper.num_inputs))
-        self.brake = np.zeros((n, stepper.num_brakes))
-        self.out = (np.zeros((n, stepper.num_impulses)), np.empty((n, stepper.info_size)))
-
-    def reset(self) -> None:
-        """Back to the initial states, and to a cold start of the (spatial) warm-start impulses."""
-        self.q[:] = self.q0
-        self.u[:] = self.u0
-        self.out[0][:] = 0.0
-
-    def command(self, tau: Sequence[float], brake: Sequence[float] = ()) -> None:
-        """Set every copy's inputs (m,) and brake bounds (k,) (inf: ideal brake)."""
-        self.tau[:] = tau
-        if self.brake.shape[1]:
-            self.brake[:] = brake
-
-    def advance(self, steps: int) -> None:
-        """``steps`` steps in one compiled call (no input checks)."""
-        self.stepper.step_batch(self.q, self.u, self.tau, self.brake, steps, check_inputs=False,
-                                out=self.out)
-
-    def state(self, copy: int = 0) -> np.ndarray:
-        """(q, u) of one copy, concatenated (2n,)."""
-        return np.concatenate([self.q[copy], self.u[copy]])
-
-    def run(self, phases: Sequence[tuple[int, Sequence[float], Sequence[float]]]) -> np.ndarray:
-        """From the initial states through (steps, inputs, brake bounds) phases, one call each."""
-        self.reset()
-        self.worst_status = 0
-        for steps, tau, brake in phases:
-            self.command(tau, brake)
-            self.advance(steps)
-            self.worst_status = max(self.worst_status, int(self.out[1][0, INFO_STATUS]))
-        return self.state()
 
 
 def point(log: Log, scene: str, series: str, parameter: str, value: float, wall_s: float | None,
