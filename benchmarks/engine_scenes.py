@@ -172,15 +172,24 @@ class Copies:
         """(q, u) of one copy, concatenated (2n,)."""
         return np.concatenate([self.q[copy], self.u[copy]])
 
-    def run(self, phases: Sequence[tuple[int, Sequence[float], Sequence[float]]]) -> np.ndarray:
-        """From the initial states through (steps, inputs, brake bounds) phases, one call each."""
+    def run(self, phases: Sequence[tuple[int, Sequence[float], Sequence[float]]],
+            stride: int | None = None) -> np.ndarray:
+        """From the initial states through (steps, inputs, brake bounds) phases.
+
+        One call per phase, returning copy 0's final (q, u) (2n,); with ``stride``, one call per
+        ``stride`` steps, returning every copy's (q, u) at the start and after each (S, N, 2n).
+        """
         self.reset()
         self.worst_status = 0
+        samples = [np.hstack([self.q, self.u])]
         for steps, tau, brake in phases:
             self.command(tau, brake)
-            self.advance(steps)
+            for chunk in [steps] if stride is None else [stride] * (steps // stride):
+                self.advance(chunk)
+                if stride is not None:
+                    samples.append(np.hstack([self.q, self.u]))
             self.worst_status = max(self.worst_status, int(self.out[1][0, INFO_STATUS]))
-        return self.state()
+        return self.state() if stride is None else np.array(samples)
 
     def with_substeps(self, num_substeps: int) -> Copies:
         """This call, set to ``num_substeps`` substeps."""

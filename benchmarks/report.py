@@ -100,14 +100,9 @@ def log_lines(ax: Any, rows: Sequence[Mapping[str, Any]], x: str, y: str, group:
 def bars(ax: Any, labels: Sequence[str], series: Mapping[str, Sequence[float | None]],
          xlabel: str, log: bool = True) -> None:
     """Grouped horizontal bars, one group per label (top to bottom), one bar per series."""
-    y = np.arange(len(labels))
-    height = 0.8 / max(len(series), 1)
-    for i, (name, values) in enumerate(series.items()):
-        ax.barh(y + (i - (len(series) - 1) / 2) * height,
-                [np.nan if v is None else v for v in values], height, label=name)
-    if log:
-        ax.set_xscale("log")
-    ax.set_yticks(y, labels, fontsize=7 if len(labels) > 20 else 8)
+    frame = pd.DataFrame(dict(series), index=list(labels), dtype=float)  # None: no bar
+    frame.plot.barh(ax=ax, width=0.8, logx=log)
+    ax.tick_params(axis="y", labelsize=7 if len(labels) > 20 else 8)
     ax.invert_yaxis()
     ax.set_xlabel(xlabel)
     ax.grid(True, axis="x", which="both", alpha=0.3)

@@ -264,18 +264,12 @@ def ball_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
             st = ctx.stepper(models.BouncingBall, p, dt, method, locate_impacts)
             num_steps = math.ceil(horizon / dt)
             q0 = np.column_stack([np.zeros(gaps.size), p.radius + gaps])  # at rest
-            single = Copies(st, q0[:1])
-            wall, repeats, final = ctx.timed(partial(single.run, [(num_steps, (0.0,), ())]))
-            replay = Copies(st, q0)
-            y = np.empty((gaps.size, num_steps + 1))
-            v = np.empty_like(y)
-            y[:, 0], v[:, 0] = replay.q[:, 1], replay.u[:, 1]
-            for k in range(1, num_steps + 1):
-                replay.advance(1)
-                y[:, k], v[:, k] = replay.q[:, 1], replay.u[:, 1]
+            phases = [(num_steps, (0.0,), ())]
+            wall, repeats, final = ctx.timed(partial(Copies(st, q0[:1]).run, phases))
+            states = Copies(st, q0).run(phases, stride=1)  # (K + 1, D, 4): x, y, x', y'
             yield point(ctx.log, "ball", series, "dt", dt, wall, repeats, "mj_one_call",
-                        ball_errors(p, gaps, y, v, dt),
-                        replay_difference=float(np.abs(replay.state() - final).max()))
+                        ball_errors(p, gaps, states[:, :, 1].T, states[:, :, 3].T, dt),
+                        replay_difference=float(np.abs(states[-1, 0] - final).max()))
 
 
 def ball_event_driven(ctx: Context) -> Iterator[dict[str, Any]]:
@@ -436,21 +430,13 @@ def _state_errors(samples: np.ndarray, reference: np.ndarray) -> dict[str, float
 def manipulator_moreau_jean(ctx: Context) -> Iterator[dict[str, Any]]:
     """Moreau-Jean points: one ``step_batch`` call per phase (timed), replayed per sample."""
     for dt in ctx.config.manipulator_time_steps:
-        phases = manipulator_phases(dt)
         run = Copies(ctx.stepper(models.BlockableManipulator, None, dt))
-        stride = _steps(SAMPLE_INTERVAL, dt)
-        wall, repeats, final = ctx.timed(partial(
-            run.run, [(steps, [torque], [bound]) for steps, torque, bound in phases]))
-        run.reset()
-        samples = [run.state()]
-        for steps, torque, bound in phases:
-            run.command([torque], [bound])
-            for _ in range(steps // stride):
-                run.advance(stride)
-                samples.append(run.state())
+        phases = [(steps, [torque], [bound]) for steps, torque, bound in manipulator_phases(dt)]
+        wall, repeats, final = ctx.timed(partial(run.run, phases))
+        samples = run.run(phases, _steps(SAMPLE_INTERVAL, dt))[:, 0]
         yield point(
             ctx.log, "manipulator", "mj_enumerative", "dt", dt, wall, repeats, "mj_per_phase",
-            _state_errors(np.array(samples), ctx.reference),
+            _state_errors(samples, ctx.reference),
             replay_difference=float(np.abs(samples[-1] - final).max()))
 
 
