@@ -5,13 +5,13 @@ Copy i of N gets scene ``i mod k`` of its model's k scenes; each timed call rest
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from benchmarks.timing import timed_call
 from mdi_envs import mechanics
 from mdi_envs.stepping import MoreauJeanStepper
 from mdi_envs.stepping._kernel import INFO_STATUS
@@ -208,10 +208,7 @@ def calibrate_substeps(make: Callable[[int], Callable[[], Any]], target_s: float
     substeps = 1
     seconds = 0.0
     for _ in range(40):
-        call = make(substeps)
-        start = time.perf_counter()
-        call()
-        seconds = time.perf_counter() - start
+        seconds = timed_call(make(substeps))[1]
         if seconds >= 0.25 * target_s or substeps >= max_substeps:
             break
         substeps = min(max_substeps,

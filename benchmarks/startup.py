@@ -15,12 +15,13 @@ import sys
 import tempfile
 import time
 from collections.abc import Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 from benchmarks import report
 from benchmarks.probes import FLOOR
-from benchmarks.timing import Progress, arguments, fresh_python, machine_info
+from benchmarks.timing import Progress, arguments, fresh_python, machine_info, timed_call
 
 REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
 """Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
@@ -49,11 +50,10 @@ def time_to_first_step(entry: str, env_id: str, cache: Path | None,
 
 def compile_all(cache: Path | None, python_path: Path | None = None) -> dict[str, Any]:
     """Wall seconds of ``mdi-envs compile all`` in a fresh interpreter, and its exit code."""
-    started = time.perf_counter()
-    process = fresh_python("-c", "import sys; from mdi_envs.cli import main; "
-                           "sys.exit(main(['compile', 'all']))", MDI_ENVS_CACHE_DIR=cache,
-                           PYTHONPATH=python_path)
-    return {"seconds": time.perf_counter() - started, "returncode": process.returncode,
+    process, seconds = timed_call(partial(
+        fresh_python, "-c", "import sys; from mdi_envs.cli import main; "
+        "sys.exit(main(['compile', 'all']))", MDI_ENVS_CACHE_DIR=cache, PYTHONPATH=python_path))
+    return {"seconds": seconds, "returncode": process.returncode,
             "output": process.stdout.strip().splitlines()[-6:]}
 
 

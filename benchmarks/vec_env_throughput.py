@@ -11,11 +11,12 @@ import json
 import sys
 import time
 from collections.abc import Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 from benchmarks import report
-from benchmarks.timing import Progress, arguments, machine_info
+from benchmarks.timing import Progress, arguments, machine_info, timed_call
 
 BACKENDS = ("batched adapter", "DummyVecEnv", "SubprocVecEnv")
 """The vector envs compared, in the order they run."""
@@ -72,9 +73,8 @@ def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str
     setup_s = time.perf_counter() - start
     model = PPO("MlpPolicy", venv, seed=0, device="cpu", **entry["algo_kwargs"])
     timer = RolloutTimer()
-    start = time.perf_counter()
-    model.learn(total_timesteps=rollouts * model.n_steps * num_envs, callback=timer)
-    train_s = time.perf_counter() - start
+    _, train_s = timed_call(partial(model.learn, rollouts * model.n_steps * num_envs,
+                                    callback=timer))
     venv.close()
     timesteps = int(model.num_timesteps)
     return {"backend": backend, "setup_s": setup_s, "train_s": train_s, "timesteps": timesteps,
