@@ -93,9 +93,10 @@ class Recovering:
     """A reference tracker on the robot, then, past the reference's end, the parking follower.
 
     The policy is ``tracker`` (a ``StateFeedbackPolicy``) until it has acted for the reference's
-    last interval (its ``last_step`` N - 1: after N steps if time-indexed); then, unless the
-    episode has ended in the goal box, it switches to ``parking_follower`` from the observed
-    pose, with the nominal model's parameters (the follower does not adapt to a mismatch).
+    last interval N - 1 (``reference_interval`` of its ``last_step``: after N steps if
+    time-indexed and on time); then, unless the episode has ended in the goal box, it switches
+    to ``parking_follower`` from the observed pose, with the nominal model's parameters (the
+    follower does not adapt to a mismatch).
 
     Args:
         tracker: the policy along the reference (reset by ``reset``).
@@ -119,7 +120,8 @@ class Recovering:
 
     def __call__(self, observation: Any) -> Any:
         """The env action at this step."""
-        if self.recovery is None and self._step and self.tracker.last_step >= self.last_node:
+        if self.recovery is None and self._step and self.tracker.reference_interval(
+                self.tracker.last_step) >= self.last_node:
             self.recovery = parking_follower(self._parameters, self._dt, self._torque,
                                              observation)
         self._step += 1

@@ -281,17 +281,18 @@ class ShrinkingHorizonMPC:
                    else np.zeros(0, dtype=bool))
         return plan.tau[0].copy(), engaged.copy()
 
-    def replan(self, step: int, q: FloatArray, u: FloatArray) -> Plan | None:
+    def replan(self, step: int, q: FloatArray, u: FloatArray,
+               relax_goal: bool = True) -> Plan | None:
         """One re-solve of the problem remaining at env step ``step`` from the state (q, u).
 
         Warm-started from the reference's rest, with its pattern: the fallbacks of a control
-        step that keep it (the goal relaxed, a later arrival); None if none found a plan. The
-        episode's records are left as they are.
+        step that keep it (the goal relaxed unless ``relax_goal`` is False, a later arrival);
+        None if none found a plan. The episode's records are left as they are.
         """
         guess = _reference_plan(self.reference)
         for _ in range(step):
             guess = guess.shifted()
-        solve, plan, _ = self._solve(guess, q, u, other_patterns=False)
+        solve, plan, _ = self._solve(guess, q, u, other_patterns=False, relax_goal=relax_goal)
         return None if solve is None else plan
 
     def decode(self, observation: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -377,11 +378,12 @@ class ShrinkingHorizonMPC:
         transcription.set_guess(start_q, start_u, guess.tau, guess.final_time, guess.impulses)
         return transcription.initial_point()
 
-    def _solve(self, guess: Plan, q: FloatArray, u: FloatArray,
-               other_patterns: bool = True) -> tuple[ModeSolve | None, Plan, str]:
+    def _solve(self, guess: Plan, q: FloatArray, u: FloatArray, other_patterns: bool = True,
+               relax_goal: bool = True) -> tuple[ModeSolve | None, Plan, str]:
         """The step's plan: fixed pattern, neighbours, goal relaxed, later arrival, freed.
 
-        ``other_patterns`` False: without the neighbours and the freed pattern.
+        ``other_patterns`` False: without the neighbours and the freed pattern; ``relax_goal``
+        False: without the relaxed goal.
         """
         initial = self._initial_point(guess, q, u)
         solve, transcription = self._fixed(guess.modes, False, q, u, initial)
@@ -394,14 +396,15 @@ class ShrinkingHorizonMPC:
             if accepted:
                 best = min(accepted, key=lambda pair: pair[0].cost)
                 return best[0], _plan_of(*best), "pattern shifted"
-        solve, transcription = self._fixed(guess.modes, True, q, u, initial)
-        if self._acceptable(solve, guess):
-            return solve, _plan_of(solve, transcription), "goal relaxed"
+        if relax_goal:
+            solve, transcription = self._fixed(guess.modes, True, q, u, initial)
+            if self._acceptable(solve, guess):
+                return solve, _plan_of(solve, transcription), "goal relaxed"
         extra_steps = MAX_EXTRA_STEPS if self.base.cost == "time" and self.grid == "env" else 0
         for extra in range(1, extra_steps + 1):
             longer = guess.delayed(extra)
             longer_initial = self._initial_point(longer, q, u)
-            for relaxed_goal in (False, True):
+            for relaxed_goal in (False, True) if relax_goal else (False,):
                 solve, transcription = self._fixed(longer.modes, relaxed_goal, q, u,
                                                    longer_initial)
                 if self._acceptable(solve, longer):

@@ -93,6 +93,10 @@ class StateFeedbackPolicy:
         applied torques overrides it (``TrackingMPC``'s friction estimate); here nothing to note.
         """
 
+    def reference_interval(self, step: int) -> int:
+        """The reference's interval that the call at ``step`` acts for (``step`` itself here)."""
+        return step
+
     def is_state_indexed(self) -> bool:
         """Whether this call's step is the state's ``nearest_node`` (else the call count)."""
         return bool(self.index_window)

@@ -38,6 +38,21 @@ goal, from where it crept in (0.1-perturbed starts 12, 15, 18, 19: 1.27-1.34x th
 time; the plan re-solved at the reversal brakes at once, and they take 0.983x). The re-solve
 costs 0.6-5.4 s of CPU time at that one step.
 
+On the robot's references (``REPLAN_AT_START``) the same re-solve, with the goal itself (a plan
+to the relaxed goal's edge, tracked a step behind, ends outside the success box), runs at the
+first step from the measured start and at the next ones until a plan is taken
+(``START_ATTEMPTS``: IPOPT may fail from one start and converge from the next step's). Tracking
+the reference's timing from a start that cannot keep it, the windows saturate behind it and the
+episode ends on the parking follower (0.1-perturbed starts 2, 3, 11, 17 of the time task:
+1.33-1.52x the optimal time), where the plan re-solved from those starts arrives 1-2 steps after
+the reference; on the effort task the plan from a start is that start's own optimum
+(1.006-1.018x the reference's effort from starts 0, 2, 11, 12), which tracking the reference
+misses (1.024-1.038x). A time-optimal plan that arrives d steps later begins d intervals before
+the reference's first: the controller's intervals start with ``MAX_EXTRA_STEPS`` copies of the
+reference's first one (as ``Plan.delayed``), used only when such a plan is taken, whose own
+points and multipliers then start their windows. The re-solve costs 0.5-40 s of CPU time at the
+first step.
+
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
 dual start) (``Opti.to_function``); a control step is one call. Its primal start is the last
@@ -61,9 +76,10 @@ parameter (``Transcription(parametric_friction=True)``): every control step firs
 last measured step to a ``optimal.traction.FrictionEstimator`` and solves with its estimate, so
 a floor with more or less grip than the model is planned for once a contact has slipped on it.
 With ``index_on_less_friction`` the controller is time-indexed until the estimate falls below
-the model's friction and state-indexed (``index_window``) from then on: with less grip the
-reference's timing is out of reach, and a time-indexed window would chase a reference that
-runs away from the robot, while a state-indexed one follows its path at the robot's pace.
+the model's friction, or until the last of ``START_ATTEMPTS`` re-solves from the start has found
+no plan, and state-indexed (``index_window``) from then on: the reference's timing is then out
+of reach, and a time-indexed window would chase a reference that runs away from the robot,
+while a state-indexed one follows its path at the robot's pace.
 
 Speed (CPU time per control step over one 0.1-perturbed episode of each task):
 
@@ -105,7 +121,7 @@ from mdi_envs._types import FloatArray
 from optimal.continuation import POLISH_RELAXATION
 from optimal.lqr import TimeVaryingLQR
 from optimal.modes import ModePattern
-from optimal.mpc import ShrinkingHorizonMPC
+from optimal.mpc import MAX_EXTRA_STEPS, ShrinkingHorizonMPC
 from optimal.observations import StateFeedbackPolicy
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
@@ -123,6 +139,13 @@ robot in time; at 15 or 30 intervals it ends the skid 0.07-0.2 m past the goal."
 REPLAN = ("manipulator_time",)
 """References whose tracker re-solves the remaining problem at the reference's torque reversals
 (see the module docstring)."""
+
+REPLAN_AT_START = ("diff_drive_time", "diff_drive_effort")
+"""References whose tracker re-solves the whole problem at the first step, from the measured
+start (see the module docstring)."""
+
+START_ATTEMPTS = 3
+"""Steps from the first at which ``REPLAN_AT_START``'s re-solve runs until a plan is taken."""
 
 DEFAULT_HORIZON = 15
 """The window of references not in ``HORIZON``."""
@@ -200,10 +223,11 @@ class TrackingMPC(StateFeedbackPolicy):
             engaged one step later, or a re-plan arriving later, once per step it is later;
             see the module docstring).
         replans: steps of this episode at which the remaining problem was re-solved and its plan
-            taken (``REPLAN``, see the module docstring).
+            taken (``REPLAN``, ``REPLAN_AT_START``, see the module docstring).
         index_on_less_friction: state-indexed only from the step at which the friction
-            estimate is first below 1 this episode (see the module docstring); False (default):
-            state-indexed whenever ``index_window`` is set.
+            estimate is first below 1 this episode, or no plan from the start was found (see
+            the module docstring); False (default): state-indexed whenever ``index_window`` is
+            set.
     """
 
     def __init__(self, reference: Reference, horizon: int | None = None,
@@ -228,27 +252,41 @@ class TrackingMPC(StateFeedbackPolicy):
             weight[:2] = self.node_weight[n:n + 2]
             self.traction = FrictionEstimator(model, parameters, reference.time_step, weight)
         self.torque_bound = float(reference.metadata["torque_bound"])
-        steps, n = len(reference.tau), self.base.model.NUM_DOFS
+        n = self.base.model.NUM_DOFS
         extension = self.horizon if self.has_brake else 0
+        self._lead = (MAX_EXTRA_STEPS if reference.name in REPLAN_AT_START
+                      and self.base.cost == "time" else 0)
+        nodes = np.concatenate([np.zeros(self._lead, dtype=int), np.arange(len(reference.q))])
+        intervals = nodes[:-1]
+        steps = len(intervals)
         rest = np.concatenate([reference.q[-1], np.zeros(n)])
-        self._x = np.vstack([np.hstack([reference.q, reference.u]),
+        self._x = np.vstack([np.hstack([reference.q, reference.u])[nodes],
                              np.repeat(rest[None], extension, 0)])
-        self._tau = np.vstack([reference.tau, np.zeros((extension, len(reference.tau[0])))])
+        self._tau = np.vstack([reference.tau[intervals],
+                               np.zeros((extension, len(reference.tau[0])))])
+        self._impulses = {key: np.asarray(reference.arrays[key], dtype=float)[intervals]
+                          for key in GUESS_IMPULSES if key in reference.arrays}
         engaged, sliding = _reference_modes(reference)
+        self._pattern = ModePattern(*(None if rows is None else rows[:, intervals]
+                                      for rows in (engaged, sliding)))  # what a re-plan keeps
         if sliding is not None:  # the last interval, at rest: its neighbour's contact modes
             sliding = np.hstack([sliding[:, :-1], sliding[:, -2:-1]])
         self._modes = tuple(None if rows is None else
-                            np.hstack([rows, np.repeat(rows[:, -1:], extension, 1)])
+                            np.hstack([rows[:, intervals], np.repeat(rows[:, -1:], extension, 1)])
                             for rows in (engaged, sliding))
-        self._brake = (np.vstack([reference.brake_bound,
+        self._brake = (np.vstack([reference.brake_bound[intervals],
                                   np.repeat(reference.brake_bound[-1:], extension, 0)])
                        if self.has_brake else None)
-        self._terminal = np.concatenate([self.lqr.cost_to_go,
+        self._terminal = np.concatenate([self.lqr.cost_to_go[nodes],
                                          np.repeat(self.lqr.hold_cost_to_go[None], extension, 0)])
         self._windows: dict[bytes, _Window] = {}
         torque = np.sign(reference.tau)
-        self._reversals = set(np.flatnonzero(np.any(
-            torque[1:] * torque[:-1] < 0, axis=1)) + 1) if reference.name in REPLAN else set()
+        self._replan_intervals: set[int] = set()  # the intervals that re-solve the rest
+        if reference.name in REPLAN:
+            reversals = np.flatnonzero(np.any(torque[1:] * torque[:-1] < 0, axis=1)) + 1
+            self._replan_intervals = set(reversals.tolist())
+        if reference.name in REPLAN_AT_START:
+            self._replan_intervals = set(range(self._lead, self._lead + START_ATTEMPTS))
         self._reference_x, self._reference_tau = self._x, self._tau
         self._full: ShrinkingHorizonMPC | None = None
         self._keys = [self._window(k) for k in range(steps + (1 if extension else 0))]
@@ -265,7 +303,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self._previous: tuple[_Window, FloatArray, FloatArray, int] | None = None
         self._measured: tuple[FloatArray, FloatArray, FloatArray] | None = None
         self.index_on_less_friction = False
-        self._less_friction = False
+        self._off_timing = False
 
     def reset(self) -> None:
         """A new episode: step counter, records, warm start and friction estimate start again."""
@@ -274,23 +312,33 @@ class TrackingMPC(StateFeedbackPolicy):
         self._replanned = set()
         self._x, self._tau = self._reference_x, self._reference_tau
         self._previous = self._measured = None
-        self._less_friction = False
+        self._off_timing = False
         if self.traction is not None:
             self.traction.reset()
 
     def predicted_q(self, step: int) -> FloatArray:
         """(n,) the reference's q at env step ``step`` (the goal past the end)."""
-        x = self._x[min(max(step - len(self.delays), 0), len(self._keys) - 1)]
+        x = self._x[min(max(self._interval(step), 0), len(self._keys) - 1)]
         return x[:x.size // 2]
 
-    def is_state_indexed(self) -> bool:
-        """With ``index_window``: always, or once the friction estimate fell below 1.
+    def reference_interval(self, step: int) -> int:
+        """The reference's interval that env step ``step`` acts for: later by the ``delays``."""
+        return step - len(self.delays)
 
-        The latter with ``index_on_less_friction``, from then on for the rest of the episode.
+    def _interval(self, step: int) -> int:
+        """The controller's interval of env step ``step`` (the reference's, past the lead)."""
+        return self.reference_interval(step) + self._lead
+
+    def is_state_indexed(self) -> bool:
+        """With ``index_window``: always, or once the reference's timing is out of reach.
+
+        The latter with ``index_on_less_friction``: from the step at which the friction
+        estimate fell below 1 or the start's re-solves found no plan, for the rest of the
+        episode.
         """
         if self.traction is not None and self.traction.factor < 1.0:
-            self._less_friction = True
-        return bool(self.index_window) and (self._less_friction or not self.index_on_less_friction)
+            self._off_timing = True
+        return bool(self.index_window) and (self._off_timing or not self.index_on_less_friction)
 
     def control(self, step: int, q: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(torques (m,) [N m], brake bounds (k,)) at env step ``step`` in the state (q, u).
@@ -316,14 +364,16 @@ class TrackingMPC(StateFeedbackPolicy):
                 self.traction.update(*self._measured, u)
             self.friction_factors.append(self.traction.factor)
             extra = [self.traction.factor]
-        if step >= len(self._keys):  # past the reference: the hold window, or the LQR
-            if not self.has_brake:
-                return self.lqr.control(step, q, u)
-        k = min(step - len(self.delays), len(self._keys) - 1)
-        if k in self._reversals and k not in self._replanned and not self.is_state_indexed():
+        if self._interval(step) >= len(self._keys) and not self.has_brake:
+            return self.lqr.control(step, q, u)  # past the reference (a brake's: the hold)
+        k = min(self._interval(step), len(self._keys) - 1)
+        if k in self._replan_intervals and k not in self._replanned and not self.is_state_indexed():
             self._replanned.add(k)
             self._replan(step, k, q, u)
-            k = min(step - len(self.delays), len(self._keys) - 1)
+            if self._replanned >= self._replan_intervals and not self.replans and (
+                    self.reference.name in REPLAN_AT_START):  # no plan from the start
+                self._off_timing = True
+            k = min(self._interval(step), len(self._keys) - 1)
         plan = self._solve(k, q, u, extra)
         iterations = plan.iterations
         if self._engages(k):  # the reference one step later: the brake engaged one step later
@@ -349,25 +399,31 @@ class TrackingMPC(StateFeedbackPolicy):
         """
         if self._full is None:
             self._full = ShrinkingHorizonMPC(self.reference, grid="env")
-        plan = self._full.replan(k, q, u)
-        steps = len(self.reference.tau)
+        at_start = self.reference.name in REPLAN_AT_START  # the goal itself, not relaxed
+        plan = self._full.replan(k - self._lead, q, u, relax_goal=not at_start)
+        steps = len(self.reference.tau) + self._lead
         later = 0 if plan is None else plan.num_intervals - (steps - k)
         if plan is None or k - later < 0 or plan.modes.key() != ModePattern(
-                *(None if rows is None else rows[:, k - later:steps]
-                  for rows in self._modes)).key():
+                *(None if rows is None else rows[:, k - later:]
+                  for rows in (self._pattern.engaged, self._pattern.sliding))).key():
             return
         self._x, self._tau = self._x.copy(), self._tau.copy()
         self._x[k - later:steps + 1] = np.hstack([plan.q, plan.u])
         self._tau[k - later:steps] = plan.tau
+        for j in range(k - later, k):  # the lead's windows: their start from the plan
+            self._reference_points[j] = self._reference_point(j)
+            self._reference_multipliers[j] = self._reference_multiplier(j)
         self.delays += [step] * later
         self.replans.append(step)
+        if at_start:  # a plan taken: no more attempts
+            self._replanned |= self._replan_intervals
 
     def _engages(self, k: int) -> bool:
         """Whether interval k engages a brake released over k - 1, in a window into the hold.
 
         The window of k reaches the hold past the reference's end (see the module docstring).
         """
-        engaged, steps = self._modes[0], len(self.reference.tau)
+        engaged, steps = self._modes[0], len(self.reference.tau) + self._lead
         return engaged is not None and steps - self.horizon < k < steps and bool(
             np.any(engaged[:, k] & ~engaged[:, k - 1]))
 
@@ -445,8 +501,7 @@ class TrackingMPC(StateFeedbackPolicy):
         window = self._windows[self._keys[k]]
         length, n = window.shapes[0][1] - 1, self.base.model.NUM_DOFS
         span = slice(k, k + length)
-        impulses = {key: np.asarray(self.reference.arrays[key][span], dtype=float)
-                    for key in GUESS_IMPULSES if key in self.reference.arrays}
+        impulses = {key: value[span] for key, value in self._impulses.items()}
         x = self._x[k:k + length + 1]
         window.transcription.set_guess(x[:, :n], x[:, n:], self._tau[span],
                                        length * self.reference.time_step, impulses)
@@ -497,5 +552,5 @@ def _reference_modes(reference: Reference) -> tuple[np.ndarray | None, np.ndarra
     return modes.engaged, modes.sliding
 
 
-__all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "REPLAN", "SOLVER_OPTIONS",
-           "WARM_START_PUSH", "TrackingMPC"]
+__all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "REPLAN", "REPLAN_AT_START",
+           "SOLVER_OPTIONS", "START_ATTEMPTS", "WARM_START_PUSH", "TrackingMPC"]

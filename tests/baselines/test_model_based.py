@@ -24,6 +24,9 @@ class _Still:
         self.last_step, self.calls = self.calls, self.calls + 1
         return np.zeros(2, np.float32)
 
+    def reference_interval(self, step: int) -> int:
+        return step
+
 
 def test_past_the_reference_outside_the_goal_box_it_parks_the_robot() -> None:
     """The tracker for the reference's N steps, then the parking follower into the goal box.

@@ -44,8 +44,9 @@ def test_every_window_solved_from_the_references_state_gives_its_multipliers(nam
     not zero.
     """
     controller = TrackingMPC(load_reference(name), horizon=3)
-    for key, multipliers in zip(controller._keys, controller._reference_multipliers,
-                                strict=True):
+    lead = controller._lead  # the windows before the reference's first: see the next tests
+    for key, multipliers in zip(controller._keys[lead:],
+                                controller._reference_multipliers[lead:], strict=True):
         assert multipliers.shape == (controller._windows[key].num_multipliers,)
         assert np.all(np.isfinite(multipliers)) and np.any(multipliers != 0.0)
 
@@ -247,3 +248,83 @@ def test_a_step_behind_at_the_torque_reversal_it_tracks_the_re_solved_rest(
     n = end.size // 2
     assert np.all(np.abs(end[:n] - reference.q[-1]) <= MANIPULATOR_MANEUVER.angle_tolerance)
     assert np.all(np.abs(end[n:]) <= MANIPULATOR_MANEUVER.velocity_tolerance)
+
+
+def _robot_goal_reached(x: np.ndarray) -> bool:
+    """Whether the robot's state (q, u) (5 + 5) is at rest in the goal box."""
+    from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER as goal
+
+    q, u = x[:5], x[5:]
+    heading = (q[2] - goal.goal_pose[2] + np.pi) % (2 * np.pi) - np.pi
+    return bool(np.hypot(*(q[:2] - goal.goal_pose[:2])) <= goal.position_tolerance
+                and abs(heading) <= goal.heading_tolerance
+                and np.hypot(*u[:2]) <= goal.speed_tolerance
+                and abs(u[2]) <= goal.yaw_rate_tolerance)
+
+
+def test_on_the_robots_effort_task_it_tracks_the_optimum_re_solved_from_its_start() -> None:
+    """From a perturbed start the first step re-solves the problem and tracks that plan.
+
+    The plan starts at the measured state and ends at rest in the goal box at the reference's
+    final time (a fixed horizon: never later); a reset tracks the reference again.
+    """
+    reference = load_reference("diff_drive_effort")
+    controller = TrackingMPC(reference, horizon=3)
+    controller.reset()
+    q = reference.q[0] + np.array([-0.074, 0.0, 0.02, 0.0, 0.0])
+    u = reference.u[0] + np.array([-0.094, -0.07, 0.086, 0.0, 0.0])
+    controller.control(0, q, u)
+    assert controller.replans == [0] and controller.delays == []
+    np.testing.assert_allclose(controller._x[0], np.concatenate([q, u]), atol=1e-9)
+    np.testing.assert_allclose(controller.predicted_q(0), q, atol=1e-9)
+    assert _robot_goal_reached(controller._x[len(reference.tau)])
+    assert not np.allclose(controller._tau[:len(reference.tau)], reference.tau, atol=1e-3)
+    controller.reset()
+    assert controller.replans == []
+    np.testing.assert_array_equal(controller.predicted_q(1), reference.q[1])
+
+
+@pytest.mark.slow
+def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later() -> None:
+    """The robot's time task from a start behind the reference: the re-solved plan, 1-3 steps late.
+
+    It begins at the measured state ``later`` intervals before the reference's first and ends at
+    rest in the goal box ``later`` steps after the reference's end; each step acts for the
+    reference's interval ``later`` steps before it.
+    """
+    reference = load_reference("diff_drive_time")
+    controller = TrackingMPC(reference, horizon=3)
+    controller.reset()
+    q = reference.q[0] + np.array([-0.083, -0.053, 0.06, 0.0, 0.0])
+    u = reference.u[0] + np.array([0.016, -0.081, -0.013, 0.0, 0.0])
+    controller.control(0, q, u)
+    later, steps = len(controller.delays), len(reference.tau)
+    assert controller.replans == [0] and 1 <= later <= 3
+    np.testing.assert_allclose(controller.predicted_q(0), q, atol=1e-9)
+    assert _robot_goal_reached(controller._x[-1])  # the plan's last node
+    first = controller._lead - later
+    assert np.any(controller._reference_multipliers[first] != 0.0)  # solved from the plan
+    assert controller.reference_interval(steps - 1 + later) == steps - 1
+
+
+def test_without_a_plan_from_the_start_the_robots_tracker_follows_the_path_at_its_pace(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """No re-solve from the start finds a plan: state-indexed after the last attempt.
+
+    With ``index_on_less_friction`` (the robot's time-optimal row); a reset is time-indexed
+    again.
+    """
+    from optimal.mpc import ShrinkingHorizonMPC
+    from optimal.tracking import START_ATTEMPTS
+
+    monkeypatch.setattr(ShrinkingHorizonMPC, "replan", lambda *args, **kwargs: None)
+    reference = load_reference("diff_drive_time")
+    controller = TrackingMPC(reference, horizon=3)
+    controller.index_window, controller.index_on_less_friction = 10, True
+    controller.reset()
+    for step in range(START_ATTEMPTS):
+        assert not controller.is_state_indexed()
+        controller.control(step, reference.q[step], reference.u[step])
+    assert controller.replans == [] and controller.is_state_indexed()
+    controller.reset()
+    assert not controller.is_state_indexed()
