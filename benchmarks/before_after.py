@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from benchmarks import report
-from benchmarks.timing import ROOT, Progress, arguments, fresh_python, machine_info
+from benchmarks.timing import ROOT, Log, arguments, fresh_python
 
 LIMIT = 1.10
 """An 'after' step may be at most this factor slower than 'before' (lower-is-better units)."""
@@ -41,7 +41,7 @@ def _run_in(tree: Path, scratch: Path, *args: str) -> str:
     return process.stdout
 
 
-def run_once(tree: Path, scratch: Path, log: Progress) -> dict[str, tuple[float, str]]:
+def run_once(tree: Path, scratch: Path, log: Log) -> dict[str, tuple[float, str]]:
     """{target: (value, unit)} of one round on the package in ``tree``.
 
     Each benchmark's measured targets and its speed probe at the start (the VM's phase), then
@@ -68,43 +68,40 @@ def run_once(tree: Path, scratch: Path, log: Progress) -> dict[str, tuple[float,
 
 def run(before: Path, rounds: int, output: Path) -> dict[str, Any]:
     """Alternate the trees ``rounds`` times, write the JSON and PNG; returns the record."""
-    log = Progress()
     samples: dict[str, dict[str, list[float]]] = {}  # target -> label -> values
     units: dict[str, str] = {}
-    with tempfile.TemporaryDirectory(prefix="before-after-") as scratch:
+    config = {"before_tree": str(before), "rounds": rounds, "limit": LIMIT}
+    with (report.study("before_after", output, config) as (record, log, _),
+          tempfile.TemporaryDirectory(prefix="before-after-") as scratch):
         for round_index in range(rounds):
             for label, tree in (("before", before), ("after", ROOT)):
                 log(f"round {round_index + 1}/{rounds}, {label}:")
                 for target, (value, unit) in run_once(tree, Path(scratch), log).items():
                     samples.setdefault(target, {"before": [], "after": []})[label].append(value)
                     units[target] = unit
-    rows = []
-    for target, runs in samples.items():
-        if runs["before"] and runs["after"]:
-            old, new = (statistics.median(runs[label]) for label in ("before", "after"))
-            rate = any(mark in units[target] for mark in ("/s", "×", "per s"))  # higher: better
-            slowdown = old / new if rate else new / old
-            rows.append({"target": target, "unit": units[target], "before": old, "after": new,
-                         "slowdown": slowdown, "ok": slowdown <= LIMIT,
-                         "before_runs": runs["before"], "after_runs": runs["after"]})
-    record = {"machine": machine_info(), "before_tree": str(before), "rounds": rounds,
-              "limit": LIMIT, "rows": rows}
-    output.mkdir(parents=True, exist_ok=True)
-    (output / "before_after.json").write_text(json.dumps(record, indent=2))
-    _plot(rows, output / "before_after.png")
+        record["rows"] = []
+        for target, runs in samples.items():
+            if runs["before"] and runs["after"]:
+                old, new = (statistics.median(runs[label]) for label in ("before", "after"))
+                rate = any(mark in units[target] for mark in ("/s", "×", "per s"))  # higher: better
+                slowdown = old / new if rate else new / old
+                record["rows"].append({
+                    "target": target, "unit": units[target], "before": old, "after": new,
+                    "slowdown": slowdown, "ok": slowdown <= LIMIT, "before_runs": runs["before"],
+                    "after_runs": runs["after"]})
+        _plot(record["rows"], output / "before_after.png")
     return record
 
 
 def _plot(rows: list[dict[str, Any]], path: Path) -> None:
+    """Bars of after / before per target: within the limit, or beyond it."""
     figure, axis = report.plt.subplots(figsize=(9, 0.35 * len(rows) + 1.5))
-    labels = [row["target"][:70] for row in rows]
-    axis.barh(range(len(rows)), [row["slowdown"] for row in rows],
-              color=["tab:green" if row["ok"] else "tab:red" for row in rows])
     axis.axvline(1.0, color="k", linewidth=1)
     axis.axvline(LIMIT, color="tab:red", linestyle="--", linewidth=1, label=f"limit {LIMIT:g}")
-    axis.set_yticks(range(len(rows)), labels, fontsize=7)
-    axis.set_xlabel("after / before (time; inverse for rates): > 1 is slower")
-    axis.legend(fontsize=8)
+    report.bars(axis, [row["target"][:70] for row in rows], {
+        "within the limit": [row["slowdown"] if row["ok"] else None for row in rows],
+        "slower than the limit": [None if row["ok"] else row["slowdown"] for row in rows]},
+        "after / before (time; inverse for rates): > 1 is slower", log=False)
     report.save_figure(figure, path, dpi=120)
 
 

@@ -149,7 +149,7 @@ def run_line(record: Mapping[str, Any], packages: Sequence[str]) -> str:
     """One line on the run: date, CPU, package versions, run time, load and speed probes."""
     machine = record["machine"]
     versions = ", ".join(f"{name} {machine['versions'].get(name)}" for name in packages)
-    quick = " (--quick)" if record["config"]["quick"] else ""
+    quick = " (--quick)" if record["config"].get("quick") else ""
     loads = ["/".join(f"{x:.2f}" for x in machine.get(f"load_average_at_{when}") or [])
              for when in ("start", "end")]
     probes = [f"{probe['fastest_us']:.2f} µs fastest, {probe['median_us']:.2f} µs median at {when}"
@@ -184,13 +184,13 @@ def study(name: str, output: Path, config: dict[str, Any],
           log: Log | None = None) -> Iterator[tuple[dict[str, Any], Log, Progress]]:
     """A run's (record, log, clock); at the end: load, ``speed`` probe, time, ``output/NAME.json``.
 
-    The record opens with ``machine`` (``packages``' versions) and ``config`` (with ``quick``).
+    The record opens with ``machine`` (``packages``' versions) and ``config`` (``quick``, if any).
     """
     progress = Progress()
     say = log or progress
     output.mkdir(parents=True, exist_ok=True)
     record: dict[str, Any] = {"machine": machine_info(tuple(packages)), "config": config}
-    say(f"{name} benchmark ({'quick' if config['quick'] else 'full'}) -> {output}")
+    say(f"{name} benchmark ({'quick' if config.get('quick') else 'full'}) -> {output}")
     yield record, say, progress
     finish(record, progress.elapsed, speed)
     write_json(json_safe(record), output / f"{name}.json")
@@ -241,7 +241,8 @@ def write_headline(folder: Path) -> str:
             continue
         record = json.loads((folder / filename).read_text())
         runs[name] = {"file": filename, "machine": record.get("machine"),
-                      "run_time_s": record.get("run_time_s"), "quick": record.get("quick")}
+                      "run_time_s": record.get("run_time_s"),
+                      "quick": (record.get("config") or {}).get("quick")}
         extra = {"engine": engine_peer_rows, "stress": lambda r: [stress_row(r)]}.get(name)
         rows += [{"benchmark": name, **target, "met": bool(target.get("met"))}
                  for target in (record.get("targets") or []) + (extra(record) if extra else [])]

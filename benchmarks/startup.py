@@ -21,7 +21,7 @@ from typing import Any
 
 from benchmarks import report
 from benchmarks.probes import FLOOR
-from benchmarks.timing import Progress, arguments, fresh_python, machine_info, timed_call
+from benchmarks.timing import VERSIONED_PACKAGES, arguments, fresh_python, timed_call
 
 REFERENCES = ("Acrobot-v1", "InvertedDoublePendulum-v5")
 """Gymnasium's classic-control and MuJoCo envs measured beside ours in the same run, and (last
@@ -69,13 +69,12 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
     """Run the study, write ``startup.json`` and ``startup.png``; returns the record."""
     from mdi_envs import ENV_IDS
 
-    log = Progress()
-    record: dict[str, Any] = {"machine": machine_info(), "quick": quick,
-                              "python_path": str(python_path) if python_path else None,
-                              "target_ratio": TARGET_RATIO}
     ids = [*(QUICK_IDS if quick else (*ENV_IDS, *REFERENCES)), FLOOR]
     entries = ENTRIES[:2] if quick else ENTRIES
-    with tempfile.TemporaryDirectory(prefix="mdi-envs-cache-") as scratch:
+    config = {"quick": quick, "python_path": str(python_path) if python_path else None,
+              "target_ratio": TARGET_RATIO}
+    with (report.study("startup", output, config) as (record, log, _),
+          tempfile.TemporaryDirectory(prefix="mdi-envs-cache-") as scratch):
         cache = None if quick else Path(scratch) / "warm"
         log(f"mdi-envs compile all ({'user cache' if quick else 'empty cache'})")
         record["compile_all"] = compile_all(cache, python_path)
@@ -100,11 +99,9 @@ def run(quick: bool, output: Path, python_path: Path | None = None,
                     empty = Path(tempfile.mkdtemp(dir=scratch, prefix="cold-"))
                     record["cold"][f"{env_id} {entry}"] = _summary(
                         [time_to_first_step(entry, env_id, empty, python_path)])
-    record["ratios_to_acrobot"] = _ratios(record["warm"], entries)
-    record["targets"] = _targets(record, ENV_IDS, entries)
-    output.mkdir(parents=True, exist_ok=True)
-    (output / "startup.json").write_text(json.dumps(record, indent=2))
-    _plot(record, ids, entries, output / "startup.png")
+        record["ratios_to_acrobot"] = _ratios(record["warm"], entries)
+        record["targets"] = _targets(record, ENV_IDS, entries)
+        _plot(record, ids, entries, output / "startup.png")
     return record
 
 
@@ -119,6 +116,7 @@ def _ratios(warm: dict[str, Any], entries: Sequence[str]) -> dict[str, float]:
 def _targets(record: dict[str, Any], env_ids: Sequence[str],
              entries: Sequence[str]) -> list[dict[str, Any]]:
     """The start-up targets (``benchmarks.report.target_row``)."""
+    config = record["config"]
     ratios = {key: ratio for key, ratio in record["ratios_to_acrobot"].items()
               if key.split(" ")[0] in env_ids and key.rsplit(" ", 1)[1] in ("single", "vector")}
     targets = []
@@ -126,9 +124,9 @@ def _targets(record: dict[str, Any], env_ids: Sequence[str],
         worst = max(ratios, key=ratios.__getitem__)
         targets.append(report.target_row(
             "warm start to the first env step, every id, gym.make and gym.make_vec: time / "
-            "Acrobot-v1's (worst case)", "≤", record["target_ratio"], "×", ratios[worst],
+            "Acrobot-v1's (worst case)", "≤", config["target_ratio"], "×", ratios[worst],
             f"worst: {worst}, {record['warm'][worst]['median']:.2f} s"))
-    if not record["quick"]:
+    if not config["quick"]:
         seconds = record["compile_all"]["seconds"]
         targets.append(report.target_row(
             "mdi-envs compile all on an empty cache", "≤", 30.0, "s", seconds,
@@ -147,12 +145,13 @@ def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
         series["cold (empty cache), single"] = colds
     figure, axis = report.plt.subplots(figsize=(9, 0.25 * len(ids) * len(series) + 1.8))
     acrobot = record["warm"].get("Acrobot-v1 single", {}).get("median")
+    ratio = record["config"]["target_ratio"]
     if acrobot:
-        axis.axvline(record["target_ratio"] * acrobot, color="k", linestyle="--", linewidth=1,
-                     label=f"{record['target_ratio']:g}× Acrobot-v1 (single, warm)")
+        axis.axvline(ratio * acrobot, color="k", linestyle="--", linewidth=1,
+                     label=f"{ratio:g}× Acrobot-v1 (single, warm)")
     report.bars(axis, [i.removeprefix("mdi_envs/") for i in ids], series,
                 "fresh interpreter start → first step returned [s]"
-                + (" (quick: warm, one run)" if record["quick"] else ""))
+                + (" (quick: warm, one run)" if record["config"]["quick"] else ""))
     report.save_figure(figure, path, dpi=120)
 
 
@@ -162,7 +161,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                                                        "in this folder (PYTHONPATH)"}),
                      ("--repeats", {"type": int, "default": 5, "help": "warm repetitions"}))
     record = run(args.quick, args.output, args.python_path, args.repeats)
-    print(report.targets_table(record["targets"]) if record["targets"] else "no targets (quick)")
+    print(report.summary(record, VERSIONED_PACKAGES))
     failed = [key for key, summary in record["warm"].items() if "errors" in summary]
     return 1 if failed or record["compile_all"]["returncode"] != 0 else 0
 

@@ -7,7 +7,6 @@ steps per second, rollout and update time. Needs the ``rl`` extra.
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from collections.abc import Sequence
@@ -16,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from benchmarks import report
-from benchmarks.timing import Progress, arguments, machine_info, timed_call
+from benchmarks.timing import arguments, timed_call
 
 BACKENDS = ("batched adapter", "DummyVecEnv", "SubprocVecEnv")
 """The vector envs compared, in the order they run."""
@@ -85,13 +84,13 @@ def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str
 
 def plot(record: dict[str, Any], path: Path) -> None:
     """Bars: training and rollout steps per second per vector env."""
-    results = record["results"]
+    results, config = record["results"], record["config"]
     fig, ax = report.plt.subplots(figsize=(8, 3.4))
     report.bars(ax, [r["backend"] for r in results], {
         "training (rollouts + updates)": [r["train_steps_per_s"] for r in results],
         "rollout collection only": [r["rollout_steps_per_s"] for r in results]},
-        f"environment steps / s: PPO on {record['env_id'].split('/')[-1]}, "
-        f"{record['num_envs']} copies, {results[0]['timesteps']:,} steps each", log=False)
+        f"environment steps / s: PPO on {config['env_id'].split('/')[-1]}, "
+        f"{config['num_envs']} copies, {results[0]['timesteps']:,} steps each", log=False)
     report.save_figure(fig, path, dpi=110)
 
 
@@ -102,20 +101,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                      ("--rollouts", {"type": int, "default": 20, "help": "PPO rollouts each"}),
                      ("--backends", {"nargs": "+", "choices": BACKENDS,
                                      "default": list(BACKENDS)}), quick=False)
-    say = Progress()
-    record: dict[str, Any] = {"machine": machine_info(), "env_id": args.env_id,
-                              "num_envs": args.num_envs, "rollouts": args.rollouts,
-                              "command": " ".join(["python -m benchmarks.vec_env_throughput",
-                                                   *(argv if argv is not None else sys.argv[1:])]),
-                              "results": []}  # fmt: skip
-    for backend in args.backends:
-        say(f"{backend}: {args.num_envs} copies, {args.rollouts} PPO rollouts")
-        result = measure(backend, args.env_id, args.num_envs, args.rollouts)
-        say(f"{backend}: {result['train_steps_per_s']:,.0f} steps/s")
-        record["results"].append(result)
-    args.output.mkdir(parents=True, exist_ok=True)
-    (args.output / "vec_env_throughput.json").write_text(json.dumps(record, indent=1) + "\n")
-    plot(record, args.output / "vec_env_throughput.png")
+    config = {"env_id": args.env_id, "num_envs": args.num_envs, "rollouts": args.rollouts,
+              "command": " ".join(["python -m benchmarks.vec_env_throughput",
+                                   *(argv if argv is not None else sys.argv[1:])])}
+    with report.study("vec_env_throughput", args.output, config) as (record, say, _):
+        record["results"] = []
+        for backend in args.backends:
+            say(f"{backend}: {args.num_envs} copies, {args.rollouts} PPO rollouts")
+            result = measure(backend, args.env_id, args.num_envs, args.rollouts)
+            say(f"{backend}: {result['train_steps_per_s']:,.0f} steps/s")
+            record["results"].append(result)
+        plot(record, args.output / "vec_env_throughput.png")
     print(report.flat_table(record["results"], ["backend", "setup_s", "train_steps_per_s",
                                                 "rollout_steps_per_s", "update_s"]))
     return 0
