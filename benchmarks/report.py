@@ -1,7 +1,7 @@
 """Reporting shared by every benchmark: tables, target checks, figures, JSON, the headline.
 
 A target check is ``{target, comparison, threshold, unit, measured, met, note}`` (``target_row``);
-the headline table holds every benchmark's target checks and the stress verdicts.
+the headline table holds every benchmark's target checks.
 """
 
 from __future__ import annotations
@@ -202,15 +202,6 @@ HEADLINE_SOURCES = (("engine", "engine.json"), ("envs", "envs.json"),
 """(benchmark name, result file) whose targets enter the table, in this order."""
 
 
-def stress_row(record: dict[str, Any]) -> dict[str, Any]:
-    """One row summarizing the stress cases: passed of total, failures named."""
-    cases = record.get("cases") or []
-    failed = [case["name"] for case in cases if not case.get("passed")]
-    return target_row("every stress case passes its criteria", "=", len(cases), "cases",
-                      len(cases) - len(failed), ("failed: " + ", ".join(failed)) if failed else "",
-                      met=bool(cases) and not failed)
-
-
 def engine_peer_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
     """Ours against MuJoCo's arm in the engine run."""
     rows = []  # each model's row at its largest N (the last of equals)
@@ -243,9 +234,9 @@ def write_headline(folder: Path) -> str:
         runs[name] = {"file": filename, "machine": record.get("machine"),
                       "run_time_s": record.get("run_time_s"),
                       "quick": (record.get("config") or {}).get("quick")}
-        extra = {"engine": engine_peer_rows, "stress": lambda r: [stress_row(r)]}.get(name)
+        extra = engine_peer_rows(record) if name == "engine" else []
         rows += [{"benchmark": name, **target, "met": bool(target.get("met"))}
-                 for target in (record.get("targets") or []) + (extra(record) if extra else [])]
+                 for target in (record.get("targets") or []) + extra]
     (folder / "headline.json").write_text(json.dumps({"runs": runs, "rows": rows}, indent=1,
                                                      default=str) + "\n")  # fmt: skip
     text = targets_table(rows) if rows else f"no benchmark results with targets in {folder}"

@@ -1,8 +1,8 @@
 """``mdi-envs bench stress``: run the stress cases of ``tests/stress`` and write their record.
 
 Runs the ``stress`` pytest cases (``--quick``: ``MDI_ENVS_STRESS=quick``), collects the record
-each attaches (parameters, metrics, criteria) into ``stress.json`` and their margins into
-``stress.png``. Exits with 1 if any case fails.
+each attaches (parameters, metrics, criteria) into ``stress.json`` with the target that every case
+passes, and their margins into ``stress.png``. Exits with 1 if any case fails.
 """
 
 from __future__ import annotations
@@ -50,12 +50,14 @@ def run(output: Path, quick: bool) -> dict[str, Any]:
                            plugins=[collector])
         cases = collector.cases
         record.update({
-            "config": collector.run.get("config"), "notes": collector.run.get("notes", []),
-            "cases": cases, "passed": bool(cases) and all(c["passed"] for c in cases),
-            "num_cases": len(cases), "num_failed": sum(not c["passed"] for c in cases),
+            "config": collector.run.get("config") or record["config"],
+            "notes": collector.run.get("notes", []), "cases": cases,
+            "passed": bool(cases) and all(c["passed"] for c in cases), "num_cases": len(cases),
+            "num_failed": sum(not c["passed"] for c in cases),
             "compile_s": collector.run.get("compile_s", {})})
         if code not in (pytest.ExitCode.OK, pytest.ExitCode.TESTS_FAILED):
             record["passed"], record["pytest_exit_code"] = False, int(code)
+        record["targets"] = [target(cases)]
         if cases:
             plot_margins(cases, output / "stress.png")
     return record
@@ -73,15 +75,12 @@ def margin(criterion: Mapping[str, Any]) -> float:
     return float(np.clip(value / limit, MARGIN_FLOOR, MARGIN_CEILING))
 
 
-def verdict(record: Mapping[str, Any]) -> str:
-    """One line: cases passed of all, the failing ones named, the run time, then the notes."""
-    cases = record["cases"]
-    failed = [c["name"] for c in cases if not c["passed"]]
-    mode = "quick" if (record.get("config") or {}).get("quick") else "full"
-    return "\n".join([f"Stress test ({mode}): {len(cases) - len(failed)} of {len(cases)} cases "
-                      "pass" + (f"; failing: {', '.join(failed)}" if failed else "")
-                      + f". Run time {record['run_time_s']:.0f} s.",
-                      *(f"* {note}" for note in record.get("notes") or [])])
+def target(cases: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The target check that every case passes its criteria: passed of total, failures named."""
+    failed = [case["name"] for case in cases if not case.get("passed")]
+    return report.target_row("every stress case passes its criteria", "=", len(cases), "cases",
+                             len(cases) - len(failed), ("failed: " + ", ".join(failed)) if failed
+                             else "", met=bool(cases) and not failed)
 
 
 def plot_margins(cases: Sequence[Mapping[str, Any]], path: Path) -> None:
@@ -112,7 +111,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns 1 if any case fails, else 0."""
     args = arguments(__doc__, argv)
     record = run(args.output, args.quick)
-    print(verdict(record))
+    print(report.summary(record, ("numpy", "numba", "scipy")))
     return 0 if record["passed"] else 1
 
 

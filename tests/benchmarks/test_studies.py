@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from peer_data import peer_files
 
-from benchmarks import control, engine, fc3d, report, solvers
+from benchmarks import control, engine, fc3d, report, solvers, stress
 from benchmarks.timing import TimingPlan
 
 ONCE = TimingPlan(budget_s=0.0, min_rounds=1, max_rounds=1, min_batch_s=1e-5)
@@ -140,8 +140,8 @@ def test_headline_collects_every_target(tmp_path: Path) -> None:
                     {"model": "mujoco", "copies": 64, "per_copy_step_s": 5e-7},
                     {"model": "manipulator", "copies": 4, "per_copy_step_s": 9e-7}],
         "brake_stop": {"ours": {"steps": 1}, "mujoco_default": {"steps": 40}}}))
-    (tmp_path / "stress.json").write_text(json.dumps({"cases": [
-        {"name": "one", "passed": True}, {"name": "two", "passed": False}]}))
+    (tmp_path / "stress.json").write_text(json.dumps({"targets": [stress.target([
+        {"name": "one", "passed": True}, {"name": "two", "passed": False}])]}))
     text = report.write_headline(tmp_path)
     rows = load(tmp_path / "headline.json")["rows"]
     assert [(r["benchmark"], r["met"]) for r in rows] == [

@@ -115,10 +115,17 @@ def test_report_of_a_failing_case(tmp_path: Path) -> None:
               "metrics": {}, "criteria": {"dishonest_results": at_most(0, 0)}, "passed": True},
              {"family": "lcp", "name": "lcp bad", "parameters": {"dt": [1e-3, 2e-3]},
               "metrics": {}, "criteria": {"energy": at_most(math.inf, 1.0)}, "passed": False}]
-    record = {"cases": cases, "config": {"quick": True}, "run_time_s": 1.0, "notes": ["n1"]}
-    text = bench_stress.verdict(record)
-    assert text.splitlines() == [
-        "Stress test (quick): 1 of 2 cases pass; failing: lcp bad. Run time 1 s.", "* n1"]
+    check = bench_stress.target(cases)
+    assert (check["measured"], check["threshold"], check["met"]) == (1, 2, False)
+    assert check["note"] == "failed: lcp bad"
+    assert bench_stress.target(cases[:1])["met"] and not bench_stress.target([])["met"]
+    record = {"cases": cases, "config": {"quick": True}, "run_time_s": 1.0, "notes": ["n1"],
+              "machine": {"date": "d", "cpu_model": "c", "cpu_count": 2, "versions": {}},
+              "targets": [check]}
+    text = bench_stress.report.summary(record, ())
+    assert "(--quick)" in text.splitlines()[0] and text.splitlines()[1] == "* n1"
+    assert [cell.strip() for cell in text.splitlines()[-1].split("|")[1:-1]] == [
+        "every stress case passes its criteria", "= 2 cases", "1 cases", "✗", "failed: lcp bad"]
     assert [bench_stress.margin(c["criteria"][k]) for c, k in
             ((cases[0], "dishonest_results"), (cases[1], "energy"))] == [1e-9, 1e9]
     bench_stress.plot_margins(cases, tmp_path / "stress.png")
