@@ -85,10 +85,9 @@ def run(before: Path, rounds: int, output: Path) -> dict[str, Any]:
                 old, new = (statistics.median(runs[label]) for label in ("before", "after"))
                 rate = any(mark in units[target] for mark in ("/s", "×", "per s"))  # higher: better
                 slowdown = old / new if rate else new / old
-                record["rows"].append({
-                    "target": target, "unit": units[target], "before": old, "after": new,
-                    "slowdown": slowdown, "ok": slowdown <= LIMIT, "before_runs": runs["before"],
-                    "after_runs": runs["after"]})
+                record["rows"].append({"target": target, "unit": units[target], "before": old,
+                                       "after": new, "slowdown": slowdown, "ok": slowdown <= LIMIT,
+                                       "before_runs": runs["before"], "after_runs": runs["after"]})
         _plot(record["rows"], output / "before_after.png")
     return record
 

@@ -16,30 +16,18 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks import report, timing
+from benchmarks import engine_scenes, report, timing
 from benchmarks.engine_mujoco import SCENES as MUJOCO_SCENES
 from benchmarks.engine_mujoco import MujocoArm, import_mujoco
-from benchmarks.engine_scenes import (
-    MANIPULATOR_Q,
-    TIME_STEP,
-    Copies,
-    ModelCase,
-    batch_arrays,
-    calibrate_substeps,
-    model_cases,
-)
-from benchmarks.report import bars, format_us, log_lines, plt, save_figure, summary
+from benchmarks.engine_scenes import TIME_STEP, Copies, ModelCase, batch_arrays, calibrate_substeps
+from benchmarks.report import bars, log_lines, plt, save_figure, summary
 from benchmarks.timing import Log, TimingPlan
 from mdi_envs.mechanics.compiled import compile_equations
 from mdi_envs.stepping import MoreauJeanStepper, StepShortcuts
 
-MODEL_TITLES = {
-    "ball": "bouncing ball",
-    "block": "sliding block",
-    "manipulator": "blockable manipulator",
-    "diff_drive": "diff-drive robot",
-    "mujoco": "MuJoCo arm (rollout, 1 thread)",
-}
+MODEL_TITLES = {"ball": "bouncing ball", "block": "sliding block",
+                "manipulator": "blockable manipulator", "diff_drive": "diff-drive robot",
+                "mujoco": "MuJoCo arm (rollout, 1 thread)"}
 
 
 @dataclass(frozen=True)
@@ -171,8 +159,8 @@ def single_step_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStep
 def _batched_entry(st: MoreauJeanStepper, initial: tuple, target_s: float,
                    min_substeps: int = 1) -> tuple[Copies, int]:
     """A warm-started ``Copies`` call of about ``target_s``+, and its (>= min_substeps) substeps."""
-    call = Copies(st, *initial, warm_start=True)
-    call.num_substeps = max(min_substeps, calibrate_substeps(call.with_substeps, target_s))
+    substeps = calibrate_substeps(lambda k: Copies(st, *initial, k, warm_start=True), target_s)
+    call = Copies(st, *initial, max(min_substeps, substeps), warm_start=True)
     return call, call.num_substeps
 
 
@@ -228,7 +216,7 @@ def batched_study(cases: list[ModelCase], steppers: dict[str, MoreauJeanStepper]
         measured = _per_copy_rows(entries, n, config.batch_plan, ("model",))
         rows += measured
         log(f"batched N = {n}: " + ", ".join(
-            f"{r['model']} {report.format_us(r['per_copy_step_s'])} µs (x{r['substeps']})"
+            f"{r['model']} {r['per_copy_step_s'] * 1e6:.3g} µs (x{r['substeps']})"
             for r in measured) + f"; load {timing.load_text()}")
     return rows
 
@@ -324,7 +312,7 @@ def evaluate_targets(single: list[dict], batched: list[dict]) -> list[dict[str, 
             f"{title}, batched, µs per copy-step (mix, largest N)", "≤", TARGETS_US[batched_key],
             "µs", None if largest is None else largest["per_copy_step_s"] * 1e6,
             "" if largest is None else f"N = {largest['copies']}; best over N "
-            f"{report.format_us(min(r['per_copy_step_s'] for r in rows))} µs"))
+            f"{min(r['per_copy_step_s'] for r in rows) * 1e6:.3g} µs"))
         python = [r["median_s"] for r in single if r["model"] == model and r["entry"] == "in_place"]
         targets.append(report.target_row(
             f"{title}, one InPlaceStepper.step() from Python (slowest scene)", "≤",
@@ -339,7 +327,7 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
     packages = (*timing.VERSIONED_PACKAGES, "mujoco")
     with report.study("engine", output, settings, packages, speed=True) as (record, log, clock):
         record["notes"] = []
-        cases = model_cases(config.models)
+        cases = engine_scenes.model_cases(config.models)
         mujoco, mujoco_note = import_mujoco()
         arm = MujocoArm(mujoco) if mujoco is not None else None
         if mujoco_note:
@@ -354,7 +342,8 @@ def run(config: EngineConfig, output: Path, quick: bool) -> str:
                             for c in cases]
         if arm is not None and "manipulator" in steppers:
             st, ours = steppers["manipulator"], np.empty((2, 2))
-            compile_equations(st.model).mass(np.array(MANIPULATOR_Q), st._values, ours)
+            compile_equations(st.model).mass(np.array(engine_scenes.MANIPULATOR_Q), st._values,
+                                             ours)
             record["mujoco_mass_matrix_difference"] = arm.mass_matrix_check(ours)
         studies = {"single_step": single_step_study, "per_scene": scene_study,
                    "batched": batched_study, "substeps": substeps_study,
@@ -421,8 +410,8 @@ def plot_shortcuts(shortcuts: Sequence[dict[str, Any]], path: Path) -> None:
     labels = [f"{'no solve (free vs active)' if r['shortcut'] == 'no_solve' else r['shortcut']}: "
               f"{r['model']} / {r['scene']}" + ("" if r["off_scene"] == r["scene"]
                                                 else f" vs {r['off_scene']}") + " ("
-              f"{format_us(r['on']['per_copy_step_s'])} vs "
-              f"{format_us(r['off']['per_copy_step_s'])} µs)" for r in shortcuts]
+              f"{r['on']['per_copy_step_s'] * 1e6:.3g} vs "
+              f"{r['off']['per_copy_step_s'] * 1e6:.3g} µs)" for r in shortcuts]
     bars(ax, labels, {"ratio of medians": [r["speedup"] for r in shortcuts],
                       "ratio of fastest rounds": [r["speedup_fastest_rounds"] for r in shortcuts]},
          "time off / time on (> 1: the shortcut saves time)")

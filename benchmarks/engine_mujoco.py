@@ -17,13 +17,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq
 
-from benchmarks.engine_scenes import (
-    MANIPULATOR_Q,
-    MANIPULATOR_U,
-    MOTOR_TORQUE,
-    TIME_STEP,
-    TRESCA_BOUND,
-)
+from benchmarks import engine_scenes
+from benchmarks.engine_scenes import MANIPULATOR_Q, MANIPULATOR_U, MOTOR_TORQUE, TIME_STEP
 from mdi_envs.mechanics.models.bouncing_ball import BouncingBallParameters
 
 MJCF = """
@@ -80,7 +75,7 @@ class MujocoArm:
         mj = self.mujoco
         lock = MANIPULATOR_Q[1] - MANIPULATOR_Q[0]
         self.plain = arm_model(mj, TIME_STEP, lock=lock)
-        self.tresca = arm_model(mj, TIME_STEP, frictionloss=TRESCA_BOUND, lock=lock)
+        self.tresca = arm_model(mj, TIME_STEP, frictionloss=engine_scenes.TRESCA_BOUND, lock=lock)
         self.state_spec = mj.mjtState.mjSTATE_FULLPHYSICS.value
         self.control_spec = mj.mjtState.mjSTATE_CTRL.value | mj.mjtState.mjSTATE_EQ_ACTIVE.value
         self._rollout = None
@@ -146,9 +141,7 @@ class MujocoArm:
         model, data = run.model, run.data
         data.qvel[:] = (0.0, 1.0)
         data.eq_active[0] = 1
-        trace = [1.0]
-        largest_angle = 0.0
-        steps = None
+        trace, largest_angle, steps = [1.0], 0.0, None
         for k in range(1, max_steps + 1):
             mj.mj_step(model, data)
             speed = abs(float(data.qvel[1]))
@@ -258,8 +251,7 @@ class MujocoBall:
 def calibrate_dampratio(mujoco: Any, parameters: BouncingBallParameters, time_step: float,
                         timeconst: float = BALL_TIMECONST) -> tuple[float | None, str]:
     """(dampratio whose calibration drop rebounds with eps (Brent), or None; a note)."""
-    target = parameters.restitution
-    evaluations = 0
+    target, evaluations = parameters.restitution, 0
 
     def mismatch(dampratio: float) -> float:
         nonlocal evaluations

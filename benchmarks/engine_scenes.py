@@ -157,12 +157,6 @@ class Copies:
         self.u[:] = self.u0
         self.out[0][:] = self.impulses0
 
-    def command(self, tau: Sequence[float], brake: Sequence[float] = ()) -> None:
-        """Set every copy's inputs (m,) and brake bounds (k,) (inf: ideal brake)."""
-        self.tau[:] = tau
-        if self.brake.shape[1]:
-            self.brake[:] = brake
-
     def advance(self, steps: int) -> None:
         """``steps`` steps in one compiled call (no input checks)."""
         self.stepper.step_batch(self.q, self.u, self.tau, self.brake, steps, check_inputs=False,
@@ -182,19 +176,16 @@ class Copies:
         self.reset()
         self.worst_status = 0
         samples = [np.hstack([self.q, self.u])]
-        for steps, tau, brake in phases:
-            self.command(tau, brake)
+        for steps, tau, brake in phases:  # every copy's inputs (m,), brake bounds (k,)
+            self.tau[:] = tau
+            if self.brake.shape[1]:
+                self.brake[:] = brake
             for chunk in [steps] if stride is None else [stride] * (steps // stride):
                 self.advance(chunk)
                 if stride is not None:
                     samples.append(np.hstack([self.q, self.u]))
             self.worst_status = max(self.worst_status, int(self.out[1][0, INFO_STATUS]))
         return self.state() if stride is None else np.array(samples)
-
-    def with_substeps(self, num_substeps: int) -> Copies:
-        """This call, set to ``num_substeps`` substeps."""
-        self.num_substeps = num_substeps
-        return self
 
     def __call__(self) -> None:
         """Restart from the initial states and advance ``num_substeps`` steps."""
@@ -205,8 +196,7 @@ class Copies:
 def calibrate_substeps(make: Callable[[int], Callable[[], Any]], target_s: float,
                        max_substeps: int = 10**7) -> int:
     """About the smallest number of substeps for which one call lasts ``target_s``."""
-    substeps = 1
-    seconds = 0.0
+    substeps, seconds = 1, 0.0
     for _ in range(40):
         seconds = timed_call(make(substeps))[1]
         if seconds >= 0.25 * target_s or substeps >= max_substeps:

@@ -23,11 +23,6 @@ import pandas as pd  # noqa: E402
 from benchmarks.timing import VERSIONED_PACKAGES, Log, Progress, finish, machine_info  # noqa: E402
 
 
-def format_us(seconds: float | None) -> str:
-    """Seconds as µs with three significant digits (``"0.0512"``); ``–`` if absent."""
-    return "–" if seconds is None or not np.isfinite(seconds) else f"{seconds * 1e6:.3g}"
-
-
 def format_number(value: float | None) -> str:
     """Three significant digits, exponent notation outside [0.01, 1e4); ``–`` if absent."""
     if value is None or (isinstance(value, float) and not math.isfinite(value)):

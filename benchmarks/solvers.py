@@ -89,7 +89,7 @@ def size_study(config: BenchConfig, log: Log) -> list[dict[str, Any]]:
                           E.random_problem(family, n, i), entries, config.size_plan).items()]
             records += latest
             log(f"size study {family} n={n}: " + ", ".join(
-                f"{r['entry']} {report.format_us(r['time_median_s'])} µs"
+                f"{r['entry']} {r['time_median_s'] * 1e6:.3g} µs"
                 for r in aggregate_size_study(latest)))
     return records
 
@@ -104,12 +104,9 @@ def comparison_problems(config: BenchConfig, log: Log) -> list[E.Problem]:
                     for i in range(config.peer_instances)]
 
 
-FIXED_COST_PROBLEMS = (
-    E.Problem("2x2, two pivots", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
-            np.array([-5.0, -6.0])),
-    E.Problem("2x2, q >= 0", "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]),
-            np.array([1.0, 2.0])),
-)
+FIXED_COST_PROBLEMS = tuple(
+    E.Problem(name, "fixed", 2, np.array([[2.0, 1.0], [1.0, 2.0]]), np.array(q))
+    for name, q in (("2x2, two pivots", [-5.0, -6.0]), ("2x2, q >= 0", [1.0, 2.0])))
 """n = 2 problems on which a call's time is almost all fixed cost (dispatch, checks, result)."""
 
 
@@ -126,7 +123,7 @@ def compare_lemke(problems: Sequence[E.Problem], plan: TimingPlan, log: Log
                     / row["quantecon"]["time"]["median_s"] for key in ("driver", "kernel")})
         rows.append(row)
         log(f"{problem.name} (n={problem.n}): " + ", ".join(
-            f"{key} {report.format_us(row[key]['time']['median_s'])} µs" for key in keys)
+            f"{key} {row[key]['time']['median_s'] * 1e6:.3g} µs" for key in keys)
             + f"; QE status {row['quantecon']['outcome']['status']}")
     return rows
 

@@ -9,7 +9,6 @@ beside Acrobot-v1 and InvertedDoublePendulum-v5. Writes ``startup.json`` and ``s
 from __future__ import annotations
 
 import json
-import os
 import statistics
 import sys
 import tempfile
@@ -130,7 +129,7 @@ def _targets(record: dict[str, Any], env_ids: Sequence[str],
         seconds = record["compile_all"]["seconds"]
         targets.append(report.target_row(
             "mdi-envs compile all on an empty cache", "≤", 30.0, "s", seconds,
-            f"{os.cpu_count()} cores",
+            f"{record['machine']['cpu_count']} cores",
             seconds <= 30.0 and record["compile_all"]["returncode"] == 0))
     return targets
 
@@ -144,9 +143,8 @@ def _plot(record: dict[str, Any], ids: Sequence[str], entries: Sequence[str],
     if any(colds):
         series["cold (empty cache), single"] = colds
     figure, axis = report.plt.subplots(figsize=(9, 0.25 * len(ids) * len(series) + 1.8))
-    acrobot = record["warm"].get("Acrobot-v1 single", {}).get("median")
     ratio = record["config"]["target_ratio"]
-    if acrobot:
+    if acrobot := record["warm"].get("Acrobot-v1 single", {}).get("median"):
         axis.axvline(ratio * acrobot, color="k", linestyle="--", linewidth=1,
                      label=f"{ratio:g}× Acrobot-v1 (single, warm)")
     report.bars(axis, [i.removeprefix("mdi_envs/") for i in ids], series,
@@ -162,7 +160,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                      ("--repeats", {"type": int, "default": 5, "help": "warm repetitions"}))
     record = run(args.quick, args.output, args.python_path, args.repeats)
     print(report.summary(record, VERSIONED_PACKAGES))
-    failed = [key for key, summary in record["warm"].items() if "errors" in summary]
+    failed = any("errors" in summary for summary in record["warm"].values())
     return 1 if failed or record["compile_all"]["returncode"] != 0 else 0
 
 

@@ -102,12 +102,10 @@ def fresh_python(*args: str, cwd: Path = ROOT, **env: str | Path | None
 
 def _cpu_model() -> str:
     """CPU model name from /proc/cpuinfo, falling back to ``platform.processor()``."""
-    try:
+    with contextlib.suppress(OSError):
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
                 return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
     return platform.processor()
 
 

@@ -48,10 +48,7 @@ def measure(backend: str, env_id: str, num_envs: int, rollouts: int) -> dict[str
     from baselines.hyperparameters import get_hyperparameters
 
     class RolloutTimer(BaseCallback):
-        def __init__(self) -> None:
-            super().__init__()
-            self.rollout_s = 0.0
-            self._start = 0.0
+        rollout_s, _start = 0.0, 0.0  # [s] rollouts' total, the current one's start
 
         def _on_rollout_start(self) -> None:
             self._start = time.perf_counter()
