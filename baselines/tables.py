@@ -1,24 +1,29 @@
 """The Markdown tables of studies (pandas ``to_markdown``): the comparison and the robustness.
 
 ``comparison_table``: one row per env x objective x condition x controller with the IQM [95 % CI]
-over runs (n) of each score, the nominal start, the compute per step and the training budget.
+over runs (n) of each score, the nominal start, the compute per step, its real-time factor and
+the training budget.
 ``brake_use_table``: per study with a brake, how each controller uses it (engagements per episode,
 time engaged, first engagement, impulse) and the nominal episode's engaged intervals.
 ``improvement_table``: per study, the probability of improvement (rliable) of each trained
 algorithm over every other row but the optimum, in success rate and optimality score.
 ``robustness_table``: per study, one row per controller and one column per condition with the
 success rate (mean over runs) and, over the successes, the time or effort ratio (mean over the
-runs with successes). Both read the rows' aggregates (``baselines.evaluation.aggregate``).
+runs with successes), the compute per step and its real-time factor. Both read the rows'
+aggregates (``baselines.evaluation.aggregate``). The real-time factor is the mean compute per
+step over the control period, the env's dt: the reference's grid step h.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import cache
 
 import numpy as np
 import pandas as pd
 
 from baselines.records import OPTIMAL, Episode, Estimate, Row, Run, Study
+from optimal.references import load_reference
 
 
 def interval_text(estimate: Estimate, percent: bool = False) -> str:
@@ -69,6 +74,20 @@ def _compute_text(runs: Sequence[Run]) -> str:
     return f"{1e3 * seconds:.3g} ms" if seconds < 1.0 else f"{seconds:.2f} s"
 
 
+@cache
+def control_period(reference: str) -> float:
+    """The control period [s] of the studies of ``reference``: its grid step h, the env's dt."""
+    return load_reference(reference).time_step
+
+
+def _real_time_text(runs: Sequence[Run], period: float) -> str:
+    """The mean wall time of one policy call over the runs over the control period [s]."""
+    times = [run.scores.compute_per_step for run in runs]
+    if not times or any(t is None for t in times):
+        return "-"
+    return f"{float(np.mean(times)) / period:.2g}"
+
+
 def comparison_table(studies: Sequence[Study]) -> str:
     """One row per env x objective x condition x controller: IQM [95 % CI] over runs of each score.
 
@@ -96,10 +115,12 @@ def comparison_table(studies: Sequence[Study]) -> str:
                 records.append([study.env_id.split("/")[-1], study.objective,
                                 f"{condition.scale:g}", row.label, count, *cells,
                                 _nominal_text(row, label), _compute_text(row.at(label)),
+                                _real_time_text(row.at(label), control_period(study.reference)),
                                 budget_text(row, label)])  # fmt: skip
     columns = ["env", "objective", "start scale", "controller", "runs",
                "success (perturbed starts), IQM [95 % CI]", "time / optimal",
-               "effort / optimal", "nominal start", "compute / step", "training budget"]
+               "effort / optimal", "nominal start", "compute / step", "real-time factor",
+               "training budget"]
     return pd.DataFrame(records, columns=columns).to_markdown(index=False)
 
 
@@ -205,8 +226,8 @@ def robustness_table(studies: Sequence[Study]) -> str:
     """Per study a title line and a table: success (ratio over the successes) per condition.
 
     Success is the mean over the row's runs, the ratio the mean over its runs with successes
-    (each row's aggregates: ``evaluation.aggregate``); the last column is the mean wall time of
-    one policy call over all of the row's runs.
+    (each row's aggregates: ``evaluation.aggregate``); the last two columns are the mean wall
+    time of one policy call over all of the row's runs and its ratio to the control period.
     """
     parts = []
     for study in studies:
@@ -224,10 +245,11 @@ def robustness_table(studies: Sequence[Study]) -> str:
                 cells.append(f"{estimates.success_rate.mean or 0.0:.0%}"
                              + ("" if mean is None else f" ({mean:.2f})"))
             played = [run for c in study.conditions for run in row.at(c.label)]
-            records.append([row.label, runs, *cells, _compute_text(played)])
+            records.append([row.label, runs, *cells, _compute_text(played),
+                            _real_time_text(played, control_period(study.reference))])
         table = pd.DataFrame(records, columns=["controller", "runs",
                                                *(c.label for c in study.conditions),
-                                               "compute / step"])
+                                               "compute / step", "real-time factor"])
         parts.append(f"{study.env_id} {study.objective} ({study.num_starts} starts per run; "
                      f"success, {ratio}/optimal over the successes)\n\n"
                      + table.to_markdown(index=False))

@@ -277,7 +277,8 @@ def comparison_page() -> None:
              "[the baselines guide](../guide/baselines.md).", "",
              headline.headline_frame(studies).to_markdown(index=False), "",
              "In full (`baselines.tables.comparison_table`): the nominal start, the compute per "
-             "policy call and the training budget of each row.", "",
+             "policy call (mean wall time), its real-time factor (over the env's control period) "
+             "and the training budget of each row.", "",
              comparison_table(studies), ""]
     improvement = improvement_table(studies)
     if improvement:
