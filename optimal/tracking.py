@@ -44,11 +44,12 @@ first step from the measured start and at the next ones until a plan is taken
 (``START_ATTEMPTS``: IPOPT may fail from one start and converge from the next step's). Tracking
 the reference's timing from a start that cannot keep it, the windows saturate behind it and the
 episode ends on the parking follower (0.1-perturbed starts 2, 3, 11, 17 of the time task:
-1.33-1.52x the optimal time), where the plan re-solved from those starts arrives 1-2 steps after
-the reference; on the effort task the plan from a start is that start's own optimum
-(1.006-1.018x the reference's effort from starts 0, 2, 11, 12), which tracking the reference
-misses (1.024-1.038x). A time-optimal plan that arrives d steps later begins d intervals before
-the reference's first: the controller's intervals start with ``MAX_EXTRA_STEPS`` copies of the
+1.33-1.52x the optimal time), where the plan re-solved from three of them arrives one step after
+the reference (from the fourth IPOPT finds none, and the state-indexed windows bring it in at
+1.01x); on the effort task the plan from a start is that start's own optimum (1.006-1.018x the
+reference's effort from starts 0, 2, 11, 12), which tracking the reference misses
+(1.024-1.038x). A time-optimal plan that arrives d steps later begins d intervals before the
+reference's first: the controller's intervals start with ``MAX_EXTRA_STEPS`` copies of the
 reference's first one (as ``Plan.delayed``), used only when such a plan is taken, whose own
 points and multipliers then start their windows. The re-solve costs up to 27 s of CPU time at
 the first step on the time task, 3.9 s on the effort task (``mdi-envs bench control``).
@@ -211,8 +212,8 @@ class TrackingMPC(StateFeedbackPolicy):
             ``WARM_START_PUSH``.
 
     Attributes:
-        lqr: the ``TimeVaryingLQR`` whose weights, fallback control and ``node_states``,
-            ``node_weight`` (``StateFeedbackPolicy``) it uses.
+        lqr: the ``TimeVaryingLQR`` whose weights, fallback control and ``node_weight``
+            (``StateFeedbackPolicy``) it uses.
         compute_times: CPU time [s] of each control step of this episode.
         fallbacks: steps of this episode at which IPOPT failed and the LQR's control was applied.
         iterations: IPOPT's iterations per step of this episode (both windows' at a step that
@@ -241,7 +242,7 @@ class TrackingMPC(StateFeedbackPolicy):
             name: push for name in _PUSHES}),
                                **(solver_options or {}), "max_iter": self.max_iterations}
         self.lqr = TimeVaryingLQR(reference)
-        self.node_states, self.node_weight = self.lqr.node_states, self.lqr.node_weight
+        self.node_weight = self.lqr.node_weight
         self.base = make_problem(reference.name, len(reference.tau))
         self.has_brake = bool(self.base.model.NUM_BRAKES)
         model, parameters = model_of(self.base)
@@ -304,6 +305,17 @@ class TrackingMPC(StateFeedbackPolicy):
         self._measured: tuple[FloatArray, FloatArray, FloatArray] | None = None
         self.index_on_less_friction = False
         self._off_timing = False
+        self._start_delay = 0
+
+    @property
+    def node_states(self) -> FloatArray:
+        """(N + d + 1, 2n) the states a state-indexed step searches (``StateFeedbackPolicy``).
+
+        The reference's, or the plan re-solved from the start once taken (d: the steps it
+        arrives later); node j is the interval a time-indexed env step j acts for.
+        """
+        first = self._lead - self._start_delay
+        return self._x[first:len(self.reference.tau) + self._lead + 1]
 
     def reset(self) -> None:
         """A new episode: step counter, records, warm start and friction estimate start again."""
@@ -313,6 +325,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self._x, self._tau = self._reference_x, self._reference_tau
         self._previous = self._measured = None
         self._off_timing = False
+        self._start_delay = 0
         if self.traction is not None:
             self.traction.reset()
 
@@ -417,6 +430,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self.replans.append(step)
         if at_start:  # a plan taken: no more attempts
             self._replanned |= self._replan_intervals
+            self._start_delay = later
 
     def _engages(self, k: int) -> bool:
         """Whether interval k engages a brake released over k - 1, in a window into the hold.

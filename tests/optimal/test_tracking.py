@@ -290,7 +290,7 @@ def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later(
 
     It begins at the measured state ``later`` intervals before the reference's first and ends at
     rest in the goal box ``later`` steps after the reference's end; each step acts for the
-    reference's interval ``later`` steps before it.
+    reference's interval ``later`` steps before it, and a state-indexed step searches the plan.
     """
     reference = load_reference("diff_drive_time")
     controller = TrackingMPC(reference, horizon=3)
@@ -305,6 +305,9 @@ def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later(
     first = controller._lead - later
     assert np.any(controller._reference_multipliers[first] != 0.0)  # solved from the plan
     assert controller.reference_interval(steps - 1 + later) == steps - 1
+    # state-indexed, the nodes are the plan's: its last acts for the reference's last interval
+    assert len(controller.node_states) == steps + later + 1
+    np.testing.assert_allclose(controller.node_states[0], np.concatenate([q, u]), atol=1e-9)
 
 
 def test_without_a_plan_from_the_start_the_robots_tracker_follows_the_path_at_its_pace(
