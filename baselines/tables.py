@@ -65,12 +65,17 @@ def _nominal_text(row: Row, condition: str) -> str:
             if nominal.is_success else "fails")  # fmt: skip
 
 
-def _compute_text(runs: Sequence[Run]) -> str:
-    """The mean wall time of one policy call over the runs' perturbed episodes."""
+def _mean_compute(runs: Sequence[Run]) -> float | None:
+    """The mean wall time [s] of one policy call over the runs' perturbed episodes, if known."""
     times = [run.scores.compute_per_step for run in runs]
-    if any(t is None for t in times):
+    return None if not times or any(t is None for t in times) else float(np.mean(times))
+
+
+def _compute_text(runs: Sequence[Run]) -> str:
+    """``_mean_compute`` as text."""
+    seconds = _mean_compute(runs)
+    if seconds is None:
         return "-"
-    seconds = float(np.mean(times))
     return f"{1e3 * seconds:.3g} ms" if seconds < 1.0 else f"{seconds:.2f} s"
 
 
@@ -81,11 +86,9 @@ def control_period(reference: str) -> float:
 
 
 def _real_time_text(runs: Sequence[Run], period: float) -> str:
-    """The mean wall time of one policy call over the runs over the control period [s]."""
-    times = [run.scores.compute_per_step for run in runs]
-    if not times or any(t is None for t in times):
-        return "-"
-    return f"{float(np.mean(times)) / period:.2g}"
+    """``_mean_compute`` over the control period ``period`` [s], as text."""
+    seconds = _mean_compute(runs)
+    return "-" if seconds is None else f"{seconds / period:.2g}"
 
 
 def comparison_table(studies: Sequence[Study]) -> str:
