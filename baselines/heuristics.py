@@ -159,9 +159,10 @@ def rolling_path_follower(env: gym.Env[Any, Any], final_time: float | None = Non
                          final_time, **limits)
 
 
-PARKING_LIMITS = {"max_acceleration": 1.2, "max_wheel_torque": 1.5}
-"""``parking_follower``'s limits [m/s^2, N m]: within the rolling traction of a robot with 20 %
-less friction than the default (1.76 N m per wheel)."""
+PARKING_LIMITS = {"max_acceleration": 1.2, "max_wheel_torque": 1.5, "max_lag": 0.1}
+"""``parking_follower``'s acceleration and torque limits [m/s^2, N m], within the rolling
+traction of a robot with 20 % less friction than the default (1.76 N m per wheel), and the lag
+[m] at which its path's clock stops (``path_follower``)."""
 
 
 def parking_follower(parameters: Any, dt: float, action_torque: float, observation: Any,
@@ -193,7 +194,8 @@ def path_follower(parameters: Any, dt: float, action_torque: float,
                   poses: Sequence[Sequence[float]], handles: Sequence[float],
                   final_time: float | None = None, reverse: bool = False,
                   max_acceleration: float = 1.5, max_speed: float = 4.0,
-                  max_wheel_torque: float = 2.0, margin: float = 0.1) -> Policy:  # fmt: skip
+                  max_wheel_torque: float = 2.0, margin: float = 0.1,
+                  max_lag: float | None = None) -> Policy:  # fmt: skip
     """The tracking law of the module docstring along ``bezier_path(poses, handles)``.
 
     Args:
@@ -207,6 +209,10 @@ def path_follower(parameters: Any, dt: float, action_torque: float,
         max_speed: [m/s]. max_wheel_torque: [N m] the clip, below the ~2.2 N m rolling
             traction limit of the default robot. margin: [s] the path ends this long before
             ``final_time`` (if it can; otherwise the profile is kept as it is).
+        max_lag: [m] with it, the path's clock slows as the axle falls behind its point along
+            the path and stops at this lag (None: the clock is the env's). Under more mass or
+            less grip than ``parameters`` the heading then waits for the position, which
+            otherwise turns on time while the robot lags and ends the path off to its side.
     """
     p = parameters
     a = p.axle_offset
@@ -229,11 +235,10 @@ def path_follower(parameters: Any, dt: float, action_torque: float,
     direction = -1.0 if reverse else 1.0
     lever = direction * (a + p.stick_offset)  # the skid ahead of the axle, driving frame
     k_x, k_y, k_phi, k_v, k_w = 2.0, 4.0, 4.0, 6.0, 8.0
-    step = [0]
+    clock = [0.0]  # [s] along the path's profile
 
     def policy(obs: Any) -> Any:
-        now = step[0] * dt
-        step[0] += 1
+        now = clock[0]
         chassis = math.atan2(obs[3], obs[2]) + gphi
         phi = chassis + (math.pi if reverse else 0.0)
         x = float(obs[0]) + gx - a * math.cos(chassis)
@@ -248,6 +253,8 @@ def path_follower(parameters: Any, dt: float, action_torque: float,
         e_x = c * (ref_x - x) + s_ * (ref_y - y)  # pose error in the driving frame
         e_y = -s_ * (ref_x - x) + c * (ref_y - y)
         e_phi = wrap_angle(ref_phi - phi)
+        rate = 1.0 if max_lag is None else min(max(1.0 - e_x / max_lag, 0.0), 1.0)
+        clock[0] += rate * dt
         v_cmd = ref_v * math.cos(e_phi) + k_x * e_x
         w_cmd = ref_v * ref_k + ref_v * k_y * e_y + k_phi * math.sin(e_phi)
         # the skid's Coulomb friction, along its commanded sliding velocity (driving frame),

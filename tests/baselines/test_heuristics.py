@@ -109,3 +109,39 @@ def test_parking_follower_drives_into_the_goal_forward_or_in_reverse(behind: boo
         done = terminated or truncated
     assert terminated and info["is_success"] and info["elapsed_time"] <= 2.0
     assert (max(speeds) if behind else -min(speeds)) < 0.01  # one direction throughout
+
+
+@pytest.mark.parametrize("max_lag", [0.1, None])
+def test_parking_clock_waits_for_a_heavier_robot(max_lag: float | None) -> None:
+    """Parking in reverse from 0.31 m behind and 0.16 m beside the goal, 10 % more mass.
+
+    The heading is 0.14 rad off, turned away from the goal's side, so the path bends one way
+    and back. With the clock waiting (``max_lag``) the robot parks within 3 s; with the env's
+    clock the heading turns on time while the heavier robot lags, and it stops at rest about
+    0.1 m beside the goal, outside the box.
+    """
+    from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
+    from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
+
+    nominal = DiffDriveParameters()
+    heavy = dataclasses.replace(nominal, mass=1.1 * nominal.mass)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        env = gym.make("mdi_envs/DiffDriveRobot-v1", reset_noise_scale=0.0, parameters=heavy,
+                       max_episode_steps=125)
+    env.reset(seed=0)
+    gx, gy, gphi = DIFF_DRIVE_MANEUVER.goal_pose
+    env.unwrapped.set_state(np.array([gx - 0.16, gy - 0.31, gphi + 0.14, 0.0, 0.0]), np.zeros(5))
+    obs = env.unwrapped.state.obs[0].copy()
+    policy = heuristics.parking_follower(nominal, env.unwrapped.dt,
+                                         env.unwrapped.scene.max_wheel_torque, obs,
+                                         max_lag=max_lag)
+    done = False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        done = terminated or truncated
+    beside = abs(env.unwrapped.q[0] - gx)
+    if max_lag is None:
+        assert truncated and not info["is_success"] and beside > 0.05
+    else:
+        assert terminated and info["is_success"] and info["elapsed_time"] <= 3.0
