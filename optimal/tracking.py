@@ -294,6 +294,8 @@ class TrackingMPC(StateFeedbackPolicy):
         self._reference_points = [self._reference_point(k) for k in range(len(self._keys))]
         self._reference_multipliers = [self._reference_multiplier(k)
                                        for k in range(len(self._keys))]
+        self._reference_starts = (tuple(self._reference_points),
+                                  tuple(self._reference_multipliers))  # what a reset restores
         self.compute_times: list[float] = []
         self.fallbacks: list[int] = []
         self.iterations: list[int] = []
@@ -318,11 +320,18 @@ class TrackingMPC(StateFeedbackPolicy):
         return self._x[first:len(self.reference.tau) + self._lead + 1]
 
     def reset(self) -> None:
-        """A new episode: step counter, records, warm start and friction estimate start again."""
+        """A new episode: step counter, records, warm starts and friction estimate start again.
+
+        The windows' start points and multipliers are the reference's again: a plan taken at
+        the second or third step from the start writes its own into windows the next episode's
+        first step starts from.
+        """
         self.compute_times, self.fallbacks, self.iterations = [], [], []
         self.friction_factors, self.delays, self.replans = [], [], []
         self._replanned = set()
         self._x, self._tau = self._reference_x, self._reference_tau
+        self._reference_points = list(self._reference_starts[0])
+        self._reference_multipliers = list(self._reference_starts[1])
         self._previous = self._measured = None
         self._off_timing = False
         self._start_delay = 0

@@ -291,10 +291,13 @@ def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later(
     It begins at the measured state ``later`` intervals before the reference's first and ends at
     rest in the goal box ``later`` steps after the reference's end; each step acts for the
     reference's interval ``later`` steps before it, and a state-indexed step searches the plan.
+    A reset restores the windows' warm starts the plan rewrote.
     """
     reference = load_reference("diff_drive_time")
     controller = TrackingMPC(reference, horizon=3)
     controller.reset()
+    starts = ([p.copy() for p in controller._reference_points],
+              [m.copy() for m in controller._reference_multipliers])
     q = reference.q[0] + np.array([-0.083, -0.053, 0.06, 0.0, 0.0])
     u = reference.u[0] + np.array([0.016, -0.081, -0.013, 0.0, 0.0])
     controller.control(0, q, u)
@@ -308,6 +311,10 @@ def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later(
     # state-indexed, the nodes are the plan's: its last acts for the reference's last interval
     assert len(controller.node_states) == steps + later + 1
     np.testing.assert_allclose(controller.node_states[0], np.concatenate([q, u]), atol=1e-9)
+    controller.reset()  # the windows start from the reference again, as before the episode
+    for window, (point, multipliers) in enumerate(zip(*starts, strict=True)):
+        np.testing.assert_array_equal(controller._reference_points[window], point)
+        np.testing.assert_array_equal(controller._reference_multipliers[window], multipliers)
 
 
 def test_without_a_plan_from_the_start_the_robots_tracker_follows_the_path_at_its_pace(
