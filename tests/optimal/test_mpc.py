@@ -45,28 +45,37 @@ def short_reference() -> Reference:
         "env_kwargs": {}})
 
 
-def _play(reference: Reference, noise: float, seed: int) -> tuple[dict, ShrinkingHorizonMPC]:
+@pytest.fixture(scope="module")
+def controller(short_reference) -> ShrinkingHorizonMPC:  # noqa: ANN001
+    """One env-grid controller for the module's episodes: each test resets it first.
+
+    Its NLPs (one per horizon and pattern) are built once and shared by the episodes;
+    ``test_a_second_episode_reuses_the_built_nlps`` checks that a reset controller replays an
+    episode exactly.
+    """
+    return ShrinkingHorizonMPC(short_reference)
+
+
+def _play(controller: ShrinkingHorizonMPC, noise: float, seed: int) -> dict:
+    """A new episode of ``controller`` from a start perturbed at ``noise``: its last info."""
+    reference = controller.reference
     options = env_options(reference)
     options.update(reset_noise_scale=noise, max_episode_steps=2 * SHORT_N)
-    controller = ShrinkingHorizonMPC(reference)
-    result = rollout(reference.metadata["env_id"], controller, seed=seed, **options)
-    return result.last_info, controller
+    controller.reset()
+    return rollout(reference.metadata["env_id"], controller, seed=seed, **options).last_info
 
 
 @pytest.fixture(scope="module")
-def perturbed_episode(short_reference) -> tuple[dict, list, ShrinkingHorizonMPC, int]:  # noqa: ANN001
-    """One episode from a start perturbed at 0.01 (seed 1).
-
-    Its last info, its step records (``reset`` starts a new list), the controller and the NLPs
-    it built.
-    """
-    info, controller = _play(short_reference, 0.01, 1)
-    return info, controller.steps, controller, controller.nlps_built
+def perturbed_episode(controller: ShrinkingHorizonMPC) -> tuple[dict, list]:
+    """One episode from a start perturbed at 0.01 (seed 1): its last info and step records."""
+    info = _play(controller, 0.01, 1)
+    return info, controller.steps
 
 
 @pytest.mark.slow
-def test_mpc_from_the_nominal_start_follows_the_reference(short_reference) -> None:  # noqa: ANN001
-    info, controller = _play(short_reference, 0.0, 0)
+def test_mpc_from_the_nominal_start_follows_the_reference(
+        short_reference, controller: ShrinkingHorizonMPC) -> None:  # noqa: ANN001
+    info = _play(controller, 0.0, 0)
     assert info["is_success"]
     # the env stops at the goal's tolerance box, at the optimum's t_f at the latest
     assert info["elapsed_time"] <= short_reference.final_time + 1e-9
@@ -77,21 +86,20 @@ def test_mpc_from_the_nominal_start_follows_the_reference(short_reference) -> No
 
 @pytest.mark.slow
 def test_mpc_reaches_the_goal_from_a_perturbed_start(short_reference, perturbed_episode) -> None:  # noqa: ANN001
-    info, steps, _, _ = perturbed_episode
+    info, steps = perturbed_episode
     assert info["is_success"]
     assert info["elapsed_time"] <= 1.05 * short_reference.final_time
     assert all(step.compute_time > 0.0 for step in steps)
 
 
 @pytest.mark.slow
-def test_a_second_episode_reuses_the_built_nlps(short_reference, perturbed_episode) -> None:  # noqa: ANN001
-    first_info, first_steps, controller, built = perturbed_episode
-    options = env_options(short_reference)
-    options.update(reset_noise_scale=0.01, max_episode_steps=2 * SHORT_N)
-    controller.reset()
-    result = rollout(short_reference.metadata["env_id"], controller, seed=1, **options)
+def test_a_second_episode_reuses_the_built_nlps(controller: ShrinkingHorizonMPC,
+                                                perturbed_episode) -> None:  # noqa: ANN001
+    first_info, first_steps = perturbed_episode
+    built = controller.nlps_built
+    info = _play(controller, 0.01, 1)
     assert controller.nlps_built == built  # every (intervals, pattern) of the replay was kept
-    assert result.last_info["elapsed_time"] == first_info["elapsed_time"]
+    assert info["elapsed_time"] == first_info["elapsed_time"]
     np.testing.assert_allclose([s.cost for s in controller.steps],
                                [s.cost for s in first_steps], rtol=1e-6)
 
@@ -133,9 +141,10 @@ def test_the_neighbour_fallback_moves_only_imminent_modes() -> None:
 
 
 @pytest.mark.slow
-def test_every_time_plan_is_on_the_env_grid(perturbed_episode) -> None:  # noqa: ANN001
+def test_every_time_plan_is_on_the_env_grid(controller: ShrinkingHorizonMPC,
+                                            perturbed_episode) -> None:  # noqa: ANN001
     """t_f = N h: each plan arrives at the end of an env step, and shrinks by one step."""
-    info, steps, controller, _ = perturbed_episode
+    info, steps = perturbed_episode
     h = controller.time_step
     assert info["is_success"]
     for step in steps:
@@ -144,9 +153,10 @@ def test_every_time_plan_is_on_the_env_grid(perturbed_episode) -> None:  # noqa:
 
 
 @pytest.mark.slow
-def test_a_start_needing_more_steps_than_left_gets_them(short_reference) -> None:  # noqa: ANN001
+def test_a_start_needing_more_steps_than_left_gets_them(
+        short_reference, controller: ShrinkingHorizonMPC) -> None:  # noqa: ANN001
     """From the reference's start with two steps fewer left than it needs: two steps later."""
-    controller = ShrinkingHorizonMPC(short_reference)
+    controller.reset()
     controller._plan = _reference_plan(short_reference).shifted()  # next guess: N - 2
     controller.control(short_reference.q[0], short_reference.u[0])
     step = controller.steps[-1]
