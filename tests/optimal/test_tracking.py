@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import resource
 import warnings
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -24,6 +25,27 @@ def controller() -> TrackingMPC:
     return TrackingMPC(load_reference("manipulator_time"), horizon=WINDOW)
 
 
+@pytest.fixture(scope="module")
+def robot_trackers() -> dict[str, TrackingMPC]:
+    """A tracker (window 3) per robot reference, built once for the module's tests."""
+    return {name: TrackingMPC(load_reference(name), horizon=3)
+            for name in ("diff_drive_effort", "diff_drive_time")}
+
+
+@pytest.fixture()
+def robot_tracker(robot_trackers: dict[str, TrackingMPC], monkeypatch: pytest.MonkeyPatch
+                  ) -> Callable[[str], TrackingMPC]:
+    """The shared tracker of a robot reference, reset; attributes a test sets are restored."""
+    def tracker(name: str) -> TrackingMPC:
+        controller = robot_trackers[name]
+        for attribute in ("index_window", "index_on_less_friction"):
+            monkeypatch.setattr(controller, attribute, getattr(controller, attribute))
+        controller.reset()
+        return controller
+
+    return tracker
+
+
 def test_on_the_reference_the_plan_is_the_reference(controller: TrackingMPC) -> None:
     """No deviation: the window's optimum is the reference's own controls."""
     reference = controller.reference
@@ -35,7 +57,8 @@ def test_on_the_reference_the_plan_is_the_reference(controller: TrackingMPC) -> 
 
 
 @pytest.mark.parametrize("name", ["diff_drive_effort", "diff_drive_time"])
-def test_every_window_solved_from_the_references_state_gives_its_multipliers(name: str) -> None:
+def test_every_window_solved_from_the_references_state_gives_its_multipliers(
+        name: str, robot_tracker: Callable[[str], TrackingMPC]) -> None:
     """The stored multipliers (the start of a first or window-changing step) are a solution's.
 
     On both robot references (the time task's with ``WARM_START_PUSH``: the stored multipliers
@@ -43,7 +66,7 @@ def test_every_window_solved_from_the_references_state_gives_its_multipliers(nam
     least one nearly active inequality (a torque bound or a contact law), whose multiplier is
     not zero.
     """
-    controller = TrackingMPC(load_reference(name), horizon=3)
+    controller = robot_tracker(name)
     lead = controller._lead  # the windows before the reference's first: see the next tests
     for key, multipliers in zip(controller._keys[lead:],
                                 controller._reference_multipliers[lead:], strict=True):
@@ -121,7 +144,8 @@ def test_steps_without_a_plan_keep_no_memory() -> None:
     assert growth_kb < 10 * 1024  # the unbounded growth kept ~100 MB per such step
 
 
-def test_on_a_floor_with_less_grip_the_robots_tracker_adapts_and_follows_the_path() -> None:
+def test_on_a_floor_with_less_grip_the_robots_tracker_adapts_and_follows_the_path(
+        robot_tracker: Callable[[str], TrackingMPC]) -> None:
     """One step of the reference's start (both wheels slip) on a floor with 20 % less friction.
 
     Before it the tracker plans with the model's friction and is time-indexed; after it, with
@@ -131,8 +155,8 @@ def test_on_a_floor_with_less_grip_the_robots_tracker_adapts_and_follows_the_pat
     from optimal.problems import make_problem, model_of
     from optimal.traction import scaled_friction
 
-    reference = load_reference("diff_drive_time")
-    controller = TrackingMPC(reference, horizon=3)
+    controller = robot_tracker("diff_drive_time")
+    reference = controller.reference
     controller.index_window, controller.index_on_less_friction = 10, True
     controller.reset()
     model, parameters = model_of(make_problem(reference.name))
@@ -149,7 +173,8 @@ def test_on_a_floor_with_less_grip_the_robots_tracker_adapts_and_follows_the_pat
     assert controller.traction.factor == 1.0 and not controller.is_state_indexed()
 
 
-def test_the_robots_tracker_estimates_friction_from_the_torques_played() -> None:
+def test_the_robots_tracker_estimates_friction_from_the_torques_played(
+        robot_tracker: Callable[[str], TrackingMPC]) -> None:
     """A step played with other torques than the tracker's (a learner's, in a DAgger mixture).
 
     Told those torques (``applied``), it finds the floor's 20 % less grip from the step; fed its
@@ -159,8 +184,8 @@ def test_the_robots_tracker_estimates_friction_from_the_torques_played() -> None
     from optimal.problems import make_problem, model_of
     from optimal.traction import scaled_friction
 
-    reference = load_reference("diff_drive_time")
-    controller = TrackingMPC(reference, horizon=3)
+    controller = robot_tracker("diff_drive_time")
+    reference = controller.reference
     model, parameters = model_of(make_problem(reference.name))
     floor = MoreauJeanStepper(model, scaled_friction(parameters, 0.8), reference.time_step)
     q, u = reference.q[0], reference.u[0]
@@ -262,15 +287,15 @@ def _robot_goal_reached(x: np.ndarray) -> bool:
                 and abs(u[2]) <= goal.yaw_rate_tolerance)
 
 
-def test_on_the_robots_effort_task_it_tracks_the_optimum_re_solved_from_its_start() -> None:
+def test_on_the_robots_effort_task_it_tracks_the_optimum_re_solved_from_its_start(
+        robot_tracker: Callable[[str], TrackingMPC]) -> None:
     """From a perturbed start the first step re-solves the problem and tracks that plan.
 
     The plan starts at the measured state and ends at rest in the goal box at the reference's
     final time (a fixed horizon: never later); a reset tracks the reference again.
     """
-    reference = load_reference("diff_drive_effort")
-    controller = TrackingMPC(reference, horizon=3)
-    controller.reset()
+    controller = robot_tracker("diff_drive_effort")
+    reference = controller.reference
     q = reference.q[0] + np.array([-0.074, 0.0, 0.02, 0.0, 0.0])
     u = reference.u[0] + np.array([-0.094, -0.07, 0.086, 0.0, 0.0])
     controller.control(0, q, u)
@@ -285,7 +310,8 @@ def test_on_the_robots_effort_task_it_tracks_the_optimum_re_solved_from_its_star
 
 
 @pytest.mark.slow
-def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later() -> None:
+def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later(
+        robot_tracker: Callable[[str], TrackingMPC]) -> None:
     """The robot's time task from a start behind the reference: the re-solved plan, 1-3 steps late.
 
     It begins at the measured state ``later`` intervals before the reference's first and ends at
@@ -293,9 +319,8 @@ def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later(
     reference's interval ``later`` steps before it, and a state-indexed step searches the plan.
     A reset restores the windows' warm starts the plan rewrote.
     """
-    reference = load_reference("diff_drive_time")
-    controller = TrackingMPC(reference, horizon=3)
-    controller.reset()
+    controller = robot_tracker("diff_drive_time")
+    reference = controller.reference
     starts = ([p.copy() for p in controller._reference_points],
               [m.copy() for m in controller._reference_multipliers])
     q = reference.q[0] + np.array([-0.083, -0.053, 0.06, 0.0, 0.0])
@@ -318,7 +343,7 @@ def test_from_a_start_that_cannot_keep_the_time_it_tracks_a_plan_arriving_later(
 
 
 def test_without_a_plan_from_the_start_the_robots_tracker_follows_the_path_at_its_pace(
-        monkeypatch: pytest.MonkeyPatch) -> None:
+        monkeypatch: pytest.MonkeyPatch, robot_tracker: Callable[[str], TrackingMPC]) -> None:
     """No re-solve from the start finds a plan: state-indexed after the last attempt.
 
     With ``index_on_less_friction`` (the robot's time-optimal row); a reset is time-indexed
@@ -328,8 +353,8 @@ def test_without_a_plan_from_the_start_the_robots_tracker_follows_the_path_at_it
     from optimal.tracking import START_ATTEMPTS
 
     monkeypatch.setattr(ShrinkingHorizonMPC, "replan", lambda *args, **kwargs: None)
-    reference = load_reference("diff_drive_time")
-    controller = TrackingMPC(reference, horizon=3)
+    controller = robot_tracker("diff_drive_time")
+    reference = controller.reference
     controller.index_window, controller.index_on_less_friction = 10, True
     controller.reset()
     for step in range(START_ATTEMPTS):
