@@ -51,7 +51,7 @@ reference misses by up to 3 % of the effort. A time-optimal plan that arrives d 
 begins d intervals before the reference's first: the controller's intervals start with
 ``MAX_EXTRA_STEPS`` copies of the reference's first one (as ``Plan.delayed``), used only when
 such a plan is taken, whose own points and multipliers then start their windows. The re-solve
-costs up to 27 s of CPU time at the first step on the time task, 3.9 s on the effort task
+costs up to 31 s of CPU time at the first step on the time task, 4.6 s on the effort task
 (``mdi-envs bench control``).
 
 One NLP per distinct window pattern is built in the constructor with the start, the reference
