@@ -32,25 +32,23 @@ the controller re-solves the whole remaining problem once from the measured stat
 arriving on time, with the goal relaxed or 1-3 steps later) and tracks that plan instead of the
 reference's rest, later by the steps it arrives later (``replans``; a plan of another pattern
 is not taken). A window tracks the reference's state: from a start that lags the reference
-there it kept the torque at its bound 3-4 steps past the reversal to catch up, after which no
-plan of the pattern arrived within 3 steps, and the brake locked the arm 0.12 rad past the
-goal, from where it crept in (0.1-perturbed starts 12, 15, 18, 19: 1.27-1.34x the optimal
-time; the plan re-solved at the reversal brakes at once, and they take 0.983x). The re-solve
-costs 0.6-5.4 s of CPU time at that one step.
+there it keeps the torque at its bound a few steps past the reversal to catch up, after which
+no plan of the pattern arrives within 3 steps and the final brake locks the arm past the goal,
+from where it creeps in; the plan re-solved at the reversal brakes at once.
 
 On the robot's references (``REPLAN_AT_START``) the same re-solve, with the goal itself (a plan
 to the relaxed goal's edge, tracked a step behind, ends outside the success box), runs at the
 first step from the measured start and at the next ones until a plan is taken
 (``START_ATTEMPTS``: IPOPT may fail from one start and converge from the next step's). Tracking
 the reference's timing from a start that cannot keep it, the windows saturate behind it and the
-episode ends on the parking follower (0.1-perturbed starts 2, 3, 11, 17 of the time task:
-1.33-1.52x the optimal time), where the plan re-solved from three of them arrives one step after
-the reference (from the fourth IPOPT finds none, and the state-indexed windows bring it in at
-1.01x); on the effort task the plan from a start is that start's own optimum, which tracking the
-reference misses by up to 3 % of the effort. A time-optimal plan that arrives d steps later
-begins d intervals before the reference's first: the controller's intervals start with
-``MAX_EXTRA_STEPS`` copies of the reference's first one (as ``Plan.delayed``), used only when
-such a plan is taken, whose own points and multipliers then start their windows. The re-solve
+episode ends on the parking follower, well above the optimal time, where a plan re-solved
+from the start arrives one or more steps after the reference (when IPOPT finds none, the
+state-indexed windows bring the robot in); on the effort task the plan from a start is that
+start's own optimum, which tracking the reference misses by up to 3 % of the effort.
+A time-optimal plan that arrives d steps later begins d intervals before the reference's first:
+the controller's intervals start with ``MAX_EXTRA_STEPS`` copies of the reference's first one
+(as ``Plan.delayed``), used only when such a plan is taken, whose own points and multipliers
+then start their windows. The re-solve
 costs up to 31 s of CPU time at the first step on the time task, 4.6 s on the effort task
 (``mdi-envs bench control``).
 
