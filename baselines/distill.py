@@ -22,8 +22,8 @@ Ross et al.'s choice of the best policy on validation, in the tables' order (suc
 ratio).
 
 Perturbed starts draw the start noise half-width ``reset_noise_scale`` log-uniformly in
-``SCALES`` [rad, rad/s, m, m/s] and reset seeds from ``FIRST_TRAINING_SEED`` on, apart from the
-evaluation's seeds 0, 1, ....
+``DAggerSettings.start_scales`` [rad, rad/s, m, m/s] and reset seeds from
+``FIRST_TRAINING_SEED`` on, apart from the evaluation's seeds 0, 1, ....
 
 The learner is an SB3 policy: ``PPO``'s ``ActorCriticPolicy`` on the robots' Box actions,
 ``HybridPPO``'s policy on the manipulator with ``action_mode="hybrid"``, so the brake is a
@@ -69,9 +69,6 @@ from baselines.evaluation import DISTILLED_DIR, OBJECTIVES, Controller, play
 from baselines.model_based import EXPERTS
 from mdi_envs.provenance import git_commit
 
-SCALES = (0.01, 0.1)
-"""The range of the training starts' noise half-width [rad, rad/s, m, m/s] (log-uniform)."""
-
 FIRST_TRAINING_SEED = 1_000_000
 """Training episodes reset from seeds at or above this (evaluations use 0, 1, ...)."""
 
@@ -96,6 +93,8 @@ class DAggerSettings:
         net_arch: hidden layer widths of the policy (and of its unused value net).
         validation: perturbed starts the learner plays alone after each round; the round
             whose learner succeeds most often (the later on a tie) is the one returned.
+        start_scales: (low, high), the range of the perturbed starts' noise half-width
+            ``reset_noise_scale`` [rad, rad/s, m, m/s], drawn log-uniformly.
     """
 
     rounds: int = 6
@@ -106,6 +105,7 @@ class DAggerSettings:
     learning_rate: float = 1e-3
     net_arch: tuple[int, ...] = (256, 256)
     validation: int = 10
+    start_scales: tuple[float, float] = (0.01, 0.1)
 
     def __post_init__(self) -> None:
         for name in ("gradient_steps", "batch_size", "episodes", "validation"):
@@ -115,6 +115,10 @@ class DAggerSettings:
             raise ValueError(f"rounds must be >= 0, got {self.rounds}")
         if not 0.0 <= self.beta_decay < 1.0:
             raise ValueError(f"beta_decay must be in [0, 1), got {self.beta_decay}")
+        low, high = self.start_scales
+        if not 0.0 < low <= high:
+            raise ValueError(f"start_scales must be (low, high) with 0 < low <= high, "
+                             f"got {self.start_scales}")
         if self.learning_rate <= 0.0 or not self.net_arch or min(self.net_arch) < 1:
             raise ValueError(f"need learning_rate > 0 and a non-empty net_arch of positive "
                              f"widths, got {self.learning_rate} and {self.net_arch}")
@@ -327,9 +331,10 @@ def validation_rank(success: float, cost: float | None) -> tuple[float, float]:
     return -success, math.inf if cost is None else cost
 
 
-def perturbed_starts(rng: np.random.Generator, count: int) -> list[tuple[float, int]]:
-    """``count`` (start noise half-width log-uniform in ``SCALES``, reset seed) pairs."""
-    low, high = np.log(SCALES)
+def perturbed_starts(rng: np.random.Generator, count: int, scales: tuple[float, float]
+                     ) -> list[tuple[float, int]]:  # fmt: skip
+    """``count`` (start noise half-width log-uniform in ``scales``, reset seed) pairs."""
+    low, high = np.log(scales)
     return [(float(np.exp(rng.uniform(low, high))),
              int(rng.integers(FIRST_TRAINING_SEED, 2**31))) for _ in range(count)]  # fmt: skip
 
@@ -363,7 +368,7 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
     env_kwargs = learner_env_kwargs(env_id, controller)
     model: Any = None  # made after round 0, whose expert data give the observation statistics
     labels = _Labels([], [])
-    validation = perturbed_starts(rng, settings.validation)
+    validation = perturbed_starts(rng, settings.validation, settings.start_scales)
     sizes, losses, mixture, validated, costs = [], [], [], [], []
     best, best_round = None, 0
     for round_ in range(settings.rounds + 1):
@@ -373,7 +378,8 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
             warnings.simplefilter("ignore")
             reached = [play_labelled(env_id, {**env_kwargs, "reset_noise_scale": scale}, controller,
                                      model, beta, reset_seed, rng, labels)
-                       for scale, reset_seed in starts + perturbed_starts(rng, settings.episodes)]
+                       for scale, reset_seed in starts + perturbed_starts(rng, settings.episodes,
+                                                                           settings.start_scales)]
             if model is None:
                 model = make_learner(env_id, env_kwargs, settings, seed,
                                      np.array(labels.observations))  # fmt: skip
@@ -491,7 +497,8 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
         versions=versions(), commit=git_commit(), date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         command=f"mdi-envs distill {env_id} --expert {expert} --seeds {seed} --rounds "
                 f"{settings.rounds} --episodes {settings.episodes} "
-                f"--gradient-steps {settings.gradient_steps}")
+                f"--gradient-steps {settings.gradient_steps} --start-scales "
+                f"{settings.start_scales[0]} {settings.start_scales[1]}")
     data = {**asdict(training), "distillation": asdict(record)}
     (output / f"{stem}.json").write_text(json.dumps(data, indent=2, default=str) + "\n")
     return output / f"{stem}.zip"
@@ -513,6 +520,10 @@ def add_distill_parser(subparsers: Any) -> argparse.ArgumentParser:
                         help="perturbed starts per round")
     parser.add_argument("--gradient-steps", type=int, default=defaults.gradient_steps,
                         help="minibatch steps after each round")
+    parser.add_argument("--start-scales", type=float, nargs=2, default=defaults.start_scales,
+                        metavar=("LOW", "HIGH"),
+                        help="range of the perturbed starts' noise half-width, drawn "
+                             "log-uniformly (default: %(default)s)")
     parser.add_argument("--output", type=Path, default=DEFAULT_OUTPUT)
     parser.add_argument("--dataset", action="store_true",
                         help="also write each seed's labelled episodes as the Minari dataset "
@@ -531,7 +542,8 @@ def run_distill(args: argparse.Namespace) -> int:
         os.environ["MINARI_DATASETS_PATH"] = str(args.root.resolve())
     try:
         settings = DAggerSettings(rounds=args.rounds, episodes=args.episodes,
-                                   gradient_steps=args.gradient_steps)
+                                   gradient_steps=args.gradient_steps,
+                                   start_scales=tuple(args.start_scales))
         for seed in args.seeds:
             stem = run_name(args.env_id, OBJECTIVES.get(args.env_id, ("",))[0], ALGO, seed)
             if (args.output / f"{stem}.json").exists():
@@ -548,7 +560,7 @@ def run_distill(args: argparse.Namespace) -> int:
 
 
 __all__ = [
-    "ALGO", "DEFAULT_OUTPUT", "FIRST_TRAINING_SEED", "SCALES", "DAgger",
+    "ALGO", "DEFAULT_OUTPUT", "FIRST_TRAINING_SEED", "DAgger",
     "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill",
     "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs", "learner_policy",
     "make_learner", "native_action", "perturbed_starts", "play_labelled", "validation_cost",

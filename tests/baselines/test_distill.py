@@ -28,6 +28,7 @@ from baselines.distill import (  # noqa: E402
     learner_env_kwargs,
     make_learner,
     native_action,
+    perturbed_starts,
     play_labelled,
     validation_cost,
     validation_rank,
@@ -144,6 +145,16 @@ def test_the_best_round_succeeds_most_and_then_costs_least() -> None:
     assert validation_rank(0.0, None) > validation_rank(0.1, 100.0)
 
 
+def test_perturbed_starts_span_the_scale_range_log_uniformly() -> None:
+    starts = perturbed_starts(np.random.default_rng(0), 4000, (0.01, 0.3))
+    scales = np.array([scale for scale, _ in starts])
+    assert scales.min() >= 0.01 and scales.max() <= 0.3
+    # log-uniform: the median is the geometric mean of the bounds, a fifth below 0.01 * 30**0.2
+    assert np.median(scales) == pytest.approx(np.sqrt(0.01 * 0.3), rel=0.05)
+    assert np.mean(scales < 0.01 * 30**0.2) == pytest.approx(0.2, abs=0.03)
+    assert min(seed for _, seed in starts) >= 1_000_000  # apart from the evaluation's seeds
+
+
 def test_bad_requests_are_errors(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="no distillation task"):
         dagger("mdi_envs/BlockableManipulator-v0")
@@ -153,6 +164,10 @@ def test_bad_requests_are_errors(tmp_path: Path) -> None:
         DAggerSettings(gradient_steps=0)
     with pytest.raises(ValueError, match="beta_decay must be in"):
         DAggerSettings(beta_decay=1.0)
+    with pytest.raises(ValueError, match="start_scales must be"):
+        DAggerSettings(start_scales=(0.1, 0.01))
+    with pytest.raises(ValueError, match="start_scales must be"):
+        DAggerSettings(start_scales=(0.0, 0.1))
     with pytest.raises(ValueError, match="shape"):
         expert_label(np.zeros(3), hybrid=True)
     parser = argparse.ArgumentParser()
