@@ -21,32 +21,15 @@ Sampler: TPE (``optuna.samplers.TPESampler``, multivariate, the first 10 trials 
 trial trains from the seed ``trial.number``; every trial records its seed, the git commit, the
 evaluations and its wall time as user attributes.
 
-Storage and workers: a study lives in an RDB storage, by default the SQLite file
-``baselines/search/studies.db`` (committed). ``python -m baselines.search run STUDY`` adds
-trials to it and resumes it (``load_if_exists``); a worker that dies leaves a trial whose
-heartbeat stops, which the next worker marks failed and enqueues again. Any number of workers
-may run the same command at once: on one machine against the SQLite file, across machines
-against one shared database (``--storage postgresql://user:password@host/db`` or
-``mysql+pymysql://...``, the same URL everywhere; SQLite files on network filesystems are not
-safe). Two local workers::
-
-    python -m baselines.search run BlockableManipulator-v1_ppo --n-trials 10 &
-    python -m baselines.search run BlockableManipulator-v1_ppo --n-trials 10 &
-
-Results: ``python -m baselines.search plot STUDY`` writes ``{STUDY}_history.png`` (the
-optimization history), ``{STUDY}_importances.png`` (fANOVA parameter importances) and
-``{STUDY}_intermediate.png`` (the evaluations during each trial, where pruning acts) next to the
-storage; ``python -m baselines.search write-yaml STUDY`` writes the best trial's arguments into
-the study's entry of the rl-zoo3 file (``baselines/hyperparams``), whose budget, copies and env
-arguments it keeps.
-
-Budget, per study: 30 trials of ``Search.timesteps`` environment steps; PPO and HybridPPO
-30 x 5 x 10^5 = 1.5 x 10^7 steps (about 1.2-2 CPU-hours: the manipulator's PPO trains at
-~3.5 k steps per CPU-second with the table's settings), SAC 30 x 10^5 = 3 x 10^6 steps
-(about 3 CPU-hours at ~300 steps per CPU-second); seven studies, about 14 CPU-hours, less
-with pruning. A trial's budget is far below the shipped runs' (10^7 PPO steps on the
-manipulator): the search ranks settings by how fast they learn, which need not be how far
-they get.
+Storage: a study lives in an RDB storage, by default the committed SQLite file
+``baselines/search/studies.db``. ``python -m baselines.search run STUDY`` adds trials to it and
+resumes it; any number of workers may run it at once, against the SQLite file on one machine
+or one shared database across machines (``--storage postgresql://...``); a trial whose worker
+died is failed by its stopped heartbeat and enqueued again. ``plot STUDY`` writes the
+optimization history, the fANOVA importances and the evaluations during each trial next to the
+storage; ``write-yaml STUDY`` writes the best trial's arguments into the study's entry of the
+rl-zoo3 file (``baselines/hyperparams``). ``baselines/search/README.md`` gives the commands and
+each study's budget.
 """
 
 from __future__ import annotations

@@ -65,12 +65,15 @@ class ModePattern:
         return b"|".join(b"-" if rows is None else np.packbits(rows).tobytes()
                          + str(np.shape(rows)).encode() for rows in self._parts())
 
+    def intervals(self, index: object) -> ModePattern:
+        """The pattern of the intervals ``index`` selects (a slice or an index array)."""
+        return ModePattern(*(None if rows is None else rows[:, index] for rows in self._parts()))
+
     def refined(self, factor: int) -> ModePattern:
         """The same pattern on a grid ``factor`` times finer (each interval repeated)."""
         if factor < 1:
             raise ValueError(f"factor must be a positive integer, got {factor}")
-        return ModePattern(*(None if rows is None else np.repeat(rows, factor, axis=1)
-                             for rows in self._parts()))
+        return self.intervals(np.repeat(np.arange(self.num_intervals), factor))
 
     def neighbours(self, max_shift: int = 2) -> list[tuple[str, ModePattern]]:
         """The patterns one move away, each with a label, without duplicates or itself.

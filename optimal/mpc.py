@@ -60,12 +60,10 @@ GRIDS = ("env", "free")
 """The grids a time-optimal plan is on (the module docstring)."""
 
 GRID_OF_REFERENCE = {"manipulator_time": "env", "diff_drive_time": "free"}
-"""The grid of each time-optimal reference's MPC, chosen by measurement. The
-manipulator on the free grid lost 9 % of the optimal time in closed loop at perturbation 0.1
-(its plans' last intervals, 11 ms long, held for 35.5 ms, overshot the goal) and reached
-1.10x; on the env's grid 0.985x. The robot on the env's grid spent over 4 min on its first
-step from a 0.01-perturbed start (the fixed-time, fixed-pattern NLPs fail and the fallbacks
-build dozens more), where the free grid reaches 1.0045x at 0.1 at 0.26 s per step."""
+"""The grid of each time-optimal reference's MPC, chosen by measurement: on the free grid the
+manipulator's last planned intervals, 11 ms long but held for a 35.5 ms env step, overshoot the
+goal; on the env's grid the robot's fixed-time, fixed-pattern NLPs fail from a perturbed start
+and the fallbacks build dozens more."""
 
 MIN_HORIZON = 1
 """Fewest intervals a re-solve on the free grid plans over. The horizon is re-gridded to keep
@@ -81,17 +79,15 @@ plan by float32 rounding cannot be steered back within a fixed pattern), the re-
 the goal within this fraction of the maneuver's success tolerances."""
 
 NLP_CACHE_SIZE = 400
-"""Fixed-pattern NLPs a controller keeps (least recently used dropped). Each takes about 11 MB
-at 120 intervals (the 20-start manipulator evaluation's process grew to 4.9 GB), a robot one
-about 30 MB once solved (so up to ~12 GB).
-Building one costs 0.5-0.8 s at 120 intervals and its first solve another 0.2 s (CasADi's
-expand); a warm-started re-solve of a kept one about 0.1 s. Episodes from nearby starts visit
-the same (intervals, pattern) keys, so from the second episode on most steps reuse an NLP."""
+"""Fixed-pattern NLPs a controller keeps (least recently used dropped): about 11 MB each at
+the manipulator's 120 intervals, 30 MB for the robot once solved. Building one costs 0.5-0.8 s
+at 120 intervals, a warm-started re-solve of a kept one about 0.1 s, and episodes from nearby
+starts visit the same (intervals, pattern) keys."""
 
 NEIGHBOUR_WINDOW = 3
 """The neighbouring-pattern fallback tries only the moves that change one of the next this-many
 intervals: a measured state off the plan puts the imminent mode in doubt, not a switch seconds
-ahead. All neighbours of a robot plan (3 contacts) are 20-27 new NLPs, 30-50 s per fallback."""
+ahead."""
 
 MAX_EXTRA_STEPS = 3
 """On the env's grid, a time-optimal re-plan that cannot reach the goal in the env steps left
@@ -144,8 +140,7 @@ class Plan:
                         self.impulses)
         else:
             rest = Plan(self.q[1:], self.u[1:], self.tau[1:],
-                        ModePattern(*(None if rows is None else rows[:, 1:]
-                                      for rows in (self.modes.engaged, self.modes.sliding))),
+                        self.modes.intervals(slice(1, None)),
                         self.final_time - step,
                         {key: value[1:] for key, value in self.impulses.items()})
         if num_intervals is None or num_intervals == rest.num_intervals:
@@ -162,10 +157,9 @@ class Plan:
         front = np.zeros(steps + 1, dtype=int)
         nodes = np.concatenate([front, np.arange(1, self.num_intervals + 1)])
         intervals = np.concatenate([front[:-1], np.arange(self.num_intervals)])
-        modes = ModePattern(*(None if rows is None else rows[:, intervals]
-                              for rows in (self.modes.engaged, self.modes.sliding)))
         step = self.final_time / self.num_intervals
-        return Plan(self.q[nodes], self.u[nodes], self.tau[intervals], modes,
+        return Plan(self.q[nodes], self.u[nodes], self.tau[intervals],
+                    self.modes.intervals(intervals),
                     self.final_time + steps * step,
                     {key: value[intervals] for key, value in self.impulses.items()})
 
@@ -185,10 +179,9 @@ class Plan:
         def interpolated(values: FloatArray) -> FloatArray:
             return np.column_stack([np.interp(new, old, column) for column in values.T])
 
-        modes = ModePattern(*(None if rows is None else rows[:, holder]
-                              for rows in (self.modes.engaged, self.modes.sliding)))
         impulses = regridded_impulses(self.impulses, holder, self.num_intervals / num_intervals)
-        return Plan(interpolated(self.q), interpolated(self.u), self.tau[holder], modes,
+        return Plan(interpolated(self.q), interpolated(self.u), self.tau[holder],
+                    self.modes.intervals(holder),
                     self.final_time, impulses)
 
 

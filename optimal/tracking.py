@@ -79,34 +79,6 @@ the model's friction, or until the last of ``START_ATTEMPTS`` re-solves from the
 no plan, and state-indexed (``index_window``) from then on: the reference's timing is then out
 of reach, and a time-indexed window would chase a reference that runs away from the robot,
 while a state-indexed one follows its path at the robot's pace.
-
-Speed (CPU time per control step over one 0.1-perturbed episode of each task):
-
-- A step ends at IPOPT's first iterate within the acceptable tolerances (``acceptable_iter``
-  1, ``acceptable_tol`` 1e-2; constraint violation at most 1e-2): iterations per step, median /
-  95th percentile, robot time task 3 / 10 instead of 4 / 15, effort task 2 / 3 instead of
-  4 / 6, manipulator 15 / 23 instead of 17 / 25; the time reached is the same and the effort
-  0.03 % higher.
-- The multipliers of the window solved from the reference's state as the start of a first or
-  window-changing step (instead of zeros): on the effort task 2.4x less CPU time per episode,
-  iterations per step, median / 95th percentile, 2 / 3 instead of 6 / 21.
-- Warm-start pushes of 1e-6 instead of 1e-3 (``WARM_START_PUSH``: the shifted plan stays where
-  it was) on the manipulator and the robot's time task: iterations per step, median / 95th
-  percentile, manipulator 4 / 11 instead of 15 / 23, robot (two episodes) 1 / 8 and 2 / 6
-  instead of 3 / 14 and 2 / 16, the same arrival times; on the effort task, whose 40-interval
-  window then takes 13 / 41 and falls back 5 times in 100 steps, IPOPT's own.
-  Steps into another window start from the stored multipliers with ``WARM_START_PUSH`` too:
-  with zero multipliers, the robot's time task from 0.01-perturbed starts took 10-23
-  iterations at each step of its stick-slip changes (steps 36-48), up to 2.1 control periods,
-  and one such step in three episodes found no plan in 50; with them the 95th percentile per
-  episode is 0.33-0.47 control periods instead of 1.04-1.57, and no step falls back.
-- The NLP functions are not compiled (CasADi JIT): their evaluations (``nlp_f``, ``nlp_g``,
-  their derivatives and the Hessian) are under 10 % of a step, the rest is IPOPT and its
-  linear solver.
-- Not taken: ``mu_strategy`` adaptive (more iterations), a limited-memory Hessian (median 11
-  iterations instead of 4, 2.9x the time), no NLP or MUMPS scaling (no change beyond the noise),
-  fatrop (it needs the variables stage by stage and explicit dynamics x_{k+1} = f(x_k, u_k); the
-  transcription declares each variable over the whole grid, and its midpoint step is implicit).
 """
 
 from __future__ import annotations
@@ -154,7 +126,7 @@ MAX_ITERATIONS = 50
 
 SOLVER_OPTIONS = {"print_level": 0, "sb": "yes", "tol": 1e-4, "acceptable_tol": 1e-2,
                   "acceptable_iter": 1, "mu_init": 1e-4, "warm_start_init_point": "yes"}
-"""IPOPT's options besides the iteration limit (see the module docstring on speed)."""
+"""IPOPT's options besides the iteration limit: a step ends at the first acceptable iterate."""
 
 _PUSHES = tuple(f"warm_start_{name}" for name in ("bound_push", "bound_frac", "slack_bound_push",
                                                  "slack_bound_frac", "mult_bound_push"))
@@ -165,7 +137,7 @@ _PLUGIN_OPTIONS = {"expand": True, "print_time": False, "error_on_fail": False}
 WARM_START_PUSH = {"manipulator_time": 1e-6, "diff_drive_time": 1e-6}
 """IPOPT's warm-start pushes into the interior (``warm_start_bound_push``, ``_bound_frac``,
 ``_slack_bound_push``, ``_slack_bound_frac``, ``_mult_bound_push``) per reference, IPOPT's own
-(1e-3) for the others (see the module docstring on speed)."""
+(1e-3) for the others: a shifted plan stays where it is."""
 
 
 @dataclasses.dataclass
@@ -266,8 +238,7 @@ class TrackingMPC(StateFeedbackPolicy):
         self._impulses = {key: np.asarray(reference.arrays[key], dtype=float)[intervals]
                           for key in GUESS_IMPULSES if key in reference.arrays}
         engaged, sliding = _reference_modes(reference)
-        self._pattern = ModePattern(*(None if rows is None else rows[:, intervals]
-                                      for rows in (engaged, sliding)))  # what a re-plan keeps
+        self._pattern = ModePattern(engaged, sliding).intervals(intervals)  # a re-plan keeps it
         if sliding is not None:  # the last interval, at rest: its neighbour's contact modes
             sliding = np.hstack([sliding[:, :-1], sliding[:, -2:-1]])
         self._modes = tuple(None if rows is None else
@@ -423,9 +394,8 @@ class TrackingMPC(StateFeedbackPolicy):
         plan = self._full.replan(k - self._lead, q, u, relax_goal=not at_start)
         steps = len(self.reference.tau) + self._lead
         later = 0 if plan is None else plan.num_intervals - (steps - k)
-        if plan is None or k - later < 0 or plan.modes.key() != ModePattern(
-                *(None if rows is None else rows[:, k - later:]
-                  for rows in (self._pattern.engaged, self._pattern.sliding))).key():
+        if plan is None or k - later < 0 or (
+                plan.modes.key() != self._pattern.intervals(slice(k - later, None)).key()):
             return
         self._x, self._tau = self._x.copy(), self._tau.copy()
         self._x[k - later:steps + 1] = np.hstack([plan.q, plan.u])
@@ -472,8 +442,7 @@ class TrackingMPC(StateFeedbackPolicy):
 
     def _window(self, k: int) -> bytes:
         """The key of window k's NLP (its intervals k ... k + H - 1, as far as there are)."""
-        modes = ModePattern(*(None if rows is None else rows[:, k:k + self.horizon]
-                              for rows in self._modes))
+        modes = ModePattern(*self._modes).intervals(slice(k, k + self.horizon))
         key = modes.key()
         if key not in self._windows:
             self._windows[key] = self._build(modes)
