@@ -1,24 +1,15 @@
-"""Model-based controller rows of the comparison: the time-varying LQR, the shrinking-horizon MPC.
+"""Model-based controller rows: the time-varying LQR, the tracking MPC, the shrinking-horizon MPC.
 
-``lqr_controller(env_id, objective)`` plays ``optimal.lqr.TimeVaryingLQR`` along the reference of
-(env id, objective), in the same env configuration as the MPC below; it costs microseconds per
-step and is registered in ``baselines.evaluation.CONTROLLER_FACTORIES``, so every study plays it.
-``tracking_controller`` plays ``optimal.tracking.TrackingMPC`` (its window NLPs take 10-60 s to
-build, once per row, at its first episode); ``--mpc`` adds it with the shrinking-horizon MPC. On
-the robot it is supervised (``Recovering``): a time-optimal reference rides the traction limit,
-so under more friction or mass than its model the robot ends the reference at rest outside the
-goal box, where the rolling traction of the nominal model holds it still -- the LQR's gain about
-the goal at rest is zero. Past the reference's last interval the supervisor drives a rolling path
-from where the robot is into the goal (``baselines.heuristics.parking_follower``, nominal model).
-
-``mpc_controller(env_id, objective)`` plays ``ShrinkingHorizonMPC`` around the reference of (env
-id, objective) in the env configured like the reference's open-loop replay (one env step per
-transcription interval, ``env_options``), with twice the reference's steps for time-optimal
-objectives (a perturbed start may need longer than the optimum; the effort objectives keep their
-fixed horizon). One controller serves every episode of a row, so the NLPs it built are reused.
-``mdi-envs compare ... --mpc`` adds it; it is not in ``baselines.evaluation.CONTROLLER_FACTORIES``,
-which every comparison and test plays, because it costs 0.1-1 s of compute per env step. Needs
-CasADi (the ``optimal`` extra); without it the row is left out.
+Each plays along the optimal reference of (env id, objective).
+``lqr_controller`` plays ``optimal.lqr.TimeVaryingLQR`` (microseconds per step); it is registered
+in ``baselines.evaluation.CONTROLLER_FACTORIES``, so every study plays it. ``tracking_controller``
+plays ``optimal.tracking.TrackingMPC`` (its window NLPs take 10-60 s to build, once per row), on
+the robot supervised by ``Recovering``. ``mpc_controller`` plays ``ShrinkingHorizonMPC`` in the
+env configured like the reference's open-loop replay (one env step per transcription interval,
+``env_options``), with twice the reference's steps for time-optimal objectives. The two MPCs cost
+0.1-1 s (shrinking horizon) and milliseconds (tracking) per step and are played with ``mdi-envs
+compare ... --mpc``; they need CasADi (the ``optimal`` extra), without which their rows are left
+out. One controller serves every episode of a row, so the NLPs it built are reused.
 """
 
 from __future__ import annotations
@@ -96,7 +87,9 @@ class Recovering:
     last interval N - 1 (``reference_interval`` of its ``last_step``: after N steps if
     time-indexed and on time); then, unless the episode has ended in the goal box, it switches
     to ``parking_follower`` from the observed pose, with the nominal model's parameters (the
-    follower does not adapt to a mismatch).
+    follower does not adapt to a mismatch). A time-optimal reference rides the traction limit:
+    under more friction or mass than the model the robot ends it at rest outside the goal box,
+    where the rolling traction holds it still and the LQR's gain about the goal is zero.
 
     Args:
         tracker: the policy along the reference (reset by ``reset``).

@@ -16,7 +16,7 @@ from __future__ import annotations
 import json
 import math
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -54,11 +54,14 @@ def write(path: str, text: str) -> None:
         handle.write(text)
 
 
-def copy_image(source: Path, folder: str) -> str:
-    """Copy a committed PNG into the site; returns its path relative to the page's folder."""
-    with mkdocs_gen_files.open(f"{folder}/img/{source.name}", "wb") as handle:
-        handle.write(source.read_bytes())
-    return f"img/{source.name}"
+def figures(paths: Iterable[Path]) -> list[str]:
+    """Copy committed PNGs into the results pages' folder; a Markdown image paragraph each."""
+    lines = []
+    for png in paths:
+        with mkdocs_gen_files.open(f"results/img/{png.name}", "wb") as handle:
+            handle.write(png.read_bytes())
+        lines += [f"![{png.stem}](img/{png.name})", ""]
+    return lines
 
 
 def table(rows: list[dict[str, Any]], floatfmt: str = ".4g") -> str:
@@ -256,9 +259,8 @@ def benchmark_page() -> None:
             flat = [{k: v for k, v in r.items() if not isinstance(v, (dict, list))}
                     for r in targets]
             lines += [table(flat), ""]
-        for png in sorted(folder.glob(f"{stem}*.png")) + sorted(
-                folder.glob("lemke_vs_quantecon.png") if stem == "solvers" else []):
-            lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+        lines += figures(sorted(folder.glob(f"{stem}*.png")) + sorted(
+            folder.glob("lemke_vs_quantecon.png") if stem == "solvers" else []))
     write("results/benchmarks.md", "\n".join(lines))
 
 
@@ -294,8 +296,7 @@ def comparison_page() -> None:
                   "How each controller uses the manipulator's brake over its perturbed episodes "
                   "(`baselines.tables.brake_use_table`), and when it is engaged from the "
                   "nominal start; the figures `brake_*.png` show every run.", "", brake, ""]
-    for png in sorted(folder.glob("*.png")):
-        lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    lines += figures(sorted(folder.glob("*.png")))
     floors = ROOT / "baselines" / "heuristics.json"
     if floors.exists():
         from baselines.evaluation import aggregate
@@ -342,8 +343,7 @@ def robustness_page() -> None:
              "episode is in `episodes.jsonl`). Each cell: success over 20 starts per run, and in "
              "brackets the time (or effort) over the optimum, over the successes.", "",
              robustness_table(studies), ""]
-    for png in sorted(folder.glob("*.png")):
-        lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+    lines += figures(sorted(folder.glob("*.png")))
     write("results/robustness.md", "\n".join(lines))
 
 
@@ -385,8 +385,7 @@ def references_page() -> None:
                          for c in continuous], floatfmt=".7g"), ""]
     for path in sorted((ROOT / "optimal" / "continuous").glob("*_refinement.json")):
         lines += refinement_section(load(path))
-        if path.with_suffix(".png").exists():
-            lines += [f"![{path.stem}]({copy_image(path.with_suffix('.png'), 'results')})", ""]
+        lines += figures(png for png in [path.with_suffix(".png")] if png.exists())
     for path in sorted((ROOT / "optimal" / "search").glob("*_search.json")):
         run = load(path)
         name = path.stem.removesuffix("_search")
@@ -403,9 +402,7 @@ def references_page() -> None:
                   for i, lv in enumerate(run["refinement"]["levels"])]
         lines += ["Mesh refinement (each level starts from the coarser one):", "",
                   table(refine, floatfmt=".6g"), ""]
-        png = path.with_suffix(".png")
-        if png.exists():
-            lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+        lines += figures(png for png in [path.with_suffix(".png")] if png.exists())
     write("results/references.md", "\n".join(lines))
 
 
@@ -486,8 +483,7 @@ def search_page() -> None:
                 lines += ["Best trial's evaluation and settings:", "",
                           table([result["best_evaluation"]]), "",
                           table([result["best_params"]]), ""]
-            for png in sorted(folder.glob(f"{study.study_name}_*.png")):
-                lines += [f"![{png.stem}]({copy_image(png, 'results')})", ""]
+            lines += figures(sorted(folder.glob(f"{study.study_name}_*.png")))
     write("results/search.md", "\n".join(lines))
 
 
