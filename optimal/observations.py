@@ -1,13 +1,8 @@
 """The state (q, u) of a mission env's observation, for the model-based controllers.
 
-The manipulator's observation carries its angles as (cos, sin) pairs, the robot's its pose as
-the goal offset and heading error and its velocity in the body frame; neither carries the
-robot's wheel angles, on which no dynamics depend. ``decode_observation`` inverts that against
-a predicted q (the controller's plan or reference): angles are unwrapped to the branch nearest
-the prediction and the wheel angles are taken from it. ``StateFeedbackPolicy`` is the env policy
-of a controller that acts on (q, u): decode, control, encode the action, time the call; its
-step is the number of calls this episode (time-indexed) or the reference node nearest the
-measured state (state-indexed, ``index_window``).
+Neither observation carries the robot's wheel angles, on which no dynamics depend:
+``decode_observation`` takes them, and the branch of every angle, from a predicted q.
+``StateFeedbackPolicy`` turns a controller acting on (q, u) into an env policy.
 """
 
 from __future__ import annotations

@@ -92,7 +92,7 @@ from mdi_envs._types import FloatArray
 from optimal.continuation import POLISH_RELAXATION
 from optimal.lqr import TimeVaryingLQR
 from optimal.modes import ModePattern
-from optimal.mpc import MAX_EXTRA_STEPS, ShrinkingHorizonMPC
+from optimal.mpc import MAX_EXTRA_STEPS, ShrinkingHorizonMPC, _reference_plan
 from optimal.observations import StateFeedbackPolicy
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
@@ -237,8 +237,9 @@ class TrackingMPC(StateFeedbackPolicy):
                                np.zeros((extension, len(reference.tau[0])))])
         self._impulses = {key: np.asarray(reference.arrays[key], dtype=float)[intervals]
                           for key in GUESS_IMPULSES if key in reference.arrays}
-        engaged, sliding = _reference_modes(reference)
-        self._pattern = ModePattern(engaged, sliding).intervals(intervals)  # a re-plan keeps it
+        modes = _reference_plan(reference).modes
+        self._pattern = modes.intervals(intervals)  # what a re-plan keeps
+        engaged, sliding = modes.engaged, modes.sliding
         if sliding is not None:  # the last interval, at rest: its neighbour's contact modes
             sliding = np.hstack([sliding[:, :-1], sliding[:, -2:-1]])
         self._modes = tuple(None if rows is None else
@@ -532,14 +533,6 @@ def _shift_indices(old: list[tuple[int, int]], new: list[tuple[int, int]],
         offset += rows * columns
         filler += rows * new_columns
     return np.concatenate(indices)
-
-
-def _reference_modes(reference: Reference) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """(engaged (k, N) or None, sliding (c, N) or None): the reference's mode pattern."""
-    from optimal.mpc import _reference_plan
-
-    modes = _reference_plan(reference).modes
-    return modes.engaged, modes.sliding
 
 
 __all__ = ["DEFAULT_HORIZON", "HORIZON", "MAX_ITERATIONS", "REPLAN", "REPLAN_AT_START",
