@@ -282,7 +282,7 @@ class ShrinkingHorizonMPC:
         step that keep it (the goal relaxed unless ``relax_goal`` is False, a later arrival);
         None if none found a plan. The episode's records are left as they are.
         """
-        guess = _reference_plan(self.reference)
+        guess = reference_plan(self.reference)
         for _ in range(step):
             guess = guess.shifted()
         solve, plan, _ = self._solve(guess, q, u, other_patterns=False, relax_goal=relax_goal)
@@ -300,7 +300,7 @@ class ShrinkingHorizonMPC:
 
     def _next_guess(self) -> Plan:
         if self._plan is None:
-            return _reference_plan(self.reference)
+            return reference_plan(self.reference)
         if self.grid == "env":
             return self._plan.shifted()
         return self._plan.shifted(self._horizon_after_step(self._plan))
@@ -461,7 +461,12 @@ def _plan_of(solve: ModeSolve, transcription: Transcription) -> Plan:
                 {key: arrays[key] for key in GUESS_IMPULSES if key in arrays})
 
 
-def _reference_plan(reference: Reference) -> Plan:
+def reference_plan(reference: Reference) -> Plan:
+    """The reference as a ``Plan``: its trajectory, torques, impulses and mode pattern.
+
+    A brake is engaged where its bound is positive, a contact slides where its slip speed
+    exceeds ``SLIP_TOLERANCE`` times the problem's velocity scale.
+    """
     engaged = sliding = None
     if reference.brake_bound is not None and reference.brake_bound.shape[1]:
         engaged = np.asarray(reference.brake_bound > 0.0).T
@@ -479,5 +484,5 @@ __all__ = [
     "GOAL_TOLERANCE_FRACTION", "GRIDS", "GRID_OF_REFERENCE", "MAX_EXTRA_STEPS",
     "MAX_REPLAN_GROWTH", "MIN_HORIZON", "NEIGHBOUR_WINDOW", "NLP_CACHE_SIZE", "REGRID_TOLERANCE",
     "STEP_MAX_ITERATIONS",
-    "MPCStep", "Plan", "ShrinkingHorizonMPC",
+    "MPCStep", "Plan", "ShrinkingHorizonMPC", "reference_plan",
 ]

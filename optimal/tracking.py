@@ -92,7 +92,7 @@ from mdi_envs._types import FloatArray
 from optimal.continuation import POLISH_RELAXATION
 from optimal.lqr import TimeVaryingLQR
 from optimal.modes import ModePattern
-from optimal.mpc import MAX_EXTRA_STEPS, ShrinkingHorizonMPC, _reference_plan
+from optimal.mpc import MAX_EXTRA_STEPS, ShrinkingHorizonMPC, reference_plan
 from optimal.observations import StateFeedbackPolicy
 from optimal.problems import make_problem, model_of
 from optimal.references import Reference
@@ -237,7 +237,7 @@ class TrackingMPC(StateFeedbackPolicy):
                                np.zeros((extension, len(reference.tau[0])))])
         self._impulses = {key: np.asarray(reference.arrays[key], dtype=float)[intervals]
                           for key in GUESS_IMPULSES if key in reference.arrays}
-        modes = _reference_plan(reference).modes
+        modes = reference_plan(reference).modes
         self._pattern = modes.intervals(intervals)  # what a re-plan keeps
         engaged, sliding = modes.engaged, modes.sliding
         if sliding is not None:  # the last interval, at rest: its neighbour's contact modes

@@ -20,7 +20,7 @@ from optimal.mpc import (  # noqa: E402
     Plan,
     ShrinkingHorizonMPC,
     _imminent_neighbours,
-    _reference_plan,
+    reference_plan,
 )
 from optimal.problems import make_problem  # noqa: E402
 from optimal.references import Reference  # noqa: E402
@@ -157,7 +157,7 @@ def test_a_start_needing_more_steps_than_left_gets_them(
         short_reference, controller: ShrinkingHorizonMPC) -> None:  # noqa: ANN001
     """From the reference's start with two steps fewer left than it needs: two steps later."""
     controller.reset()
-    controller._plan = _reference_plan(short_reference).shifted()  # next guess: N - 2
+    controller._plan = reference_plan(short_reference).shifted()  # next guess: N - 2
     controller.control(short_reference.q[0], short_reference.u[0])
     step = controller.steps[-1]
     assert step.fallback == "2 step(s) later" and step.horizon == SHORT_N
