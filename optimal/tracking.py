@@ -48,9 +48,8 @@ start's own optimum, which tracking the reference misses by up to 3 % of the eff
 A time-optimal plan that arrives d steps later begins d intervals before the reference's first:
 the controller's intervals start with ``MAX_EXTRA_STEPS`` copies of the reference's first one
 (as ``Plan.delayed``), used only when such a plan is taken, whose own points and multipliers
-then start their windows. The re-solve
-costs up to 31 s of CPU time at the first step on the time task, 4.6 s on the effort task
-(``mdi-envs bench control``).
+then start their windows. The re-solve costs up to 31 s of CPU time at the first step on the
+time task, 4.6 s on the effort task (``mdi-envs bench control``).
 
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
@@ -242,9 +241,10 @@ class TrackingMPC(StateFeedbackPolicy):
         engaged, sliding = modes.engaged, modes.sliding
         if sliding is not None:  # the last interval, at rest: its neighbour's contact modes
             sliding = np.hstack([sliding[:, :-1], sliding[:, -2:-1]])
-        self._modes = tuple(None if rows is None else
-                            np.hstack([rows[:, intervals], np.repeat(rows[:, -1:], extension, 1)])
-                            for rows in (engaged, sliding))
+        self._modes = ModePattern(*(
+            None if rows is None else
+            np.hstack([rows[:, intervals], np.repeat(rows[:, -1:], extension, 1)])
+            for rows in (engaged, sliding)))
         self._brake = (np.vstack([reference.brake_bound[intervals],
                                   np.repeat(reference.brake_bound[-1:], extension, 0)])
                        if self.has_brake else None)
@@ -415,7 +415,7 @@ class TrackingMPC(StateFeedbackPolicy):
 
         The window of k reaches the hold past the reference's end (see the module docstring).
         """
-        engaged, steps = self._modes[0], len(self.reference.tau) + self._lead
+        engaged, steps = self._modes.engaged, len(self.reference.tau) + self._lead
         return engaged is not None and steps - self.horizon < k < steps and bool(
             np.any(engaged[:, k] & ~engaged[:, k - 1]))
 
@@ -443,7 +443,7 @@ class TrackingMPC(StateFeedbackPolicy):
 
     def _window(self, k: int) -> bytes:
         """The key of window k's NLP (its intervals k ... k + H - 1, as far as there are)."""
-        modes = ModePattern(*self._modes).intervals(slice(k, k + self.horizon))
+        modes = self._modes.intervals(slice(k, k + self.horizon))
         key = modes.key()
         if key not in self._windows:
             self._windows[key] = self._build(modes)
