@@ -67,6 +67,7 @@ from stable_baselines3.common.torch_layers import FlattenExtractor
 from baselines.datasets import TASKS, dataset_id
 from baselines.evaluation import DISTILLED_DIR, OBJECTIVES, Controller, play
 from baselines.model_based import EXPERTS
+from baselines.time_input import counting_policy, max_steps, time_aware, with_time
 from mdi_envs.provenance import git_commit
 
 FIRST_TRAINING_SEED = 1_000_000
@@ -95,6 +96,8 @@ class DAggerSettings:
             whose learner succeeds most often (the later on a tie) is the one returned.
         start_scales: (low, high), the range of the perturbed starts' noise half-width
             ``reset_noise_scale`` [rad, rad/s, m, m/s], drawn log-uniformly.
+        observe_time: the learner also sees the normalized elapsed time
+            (``baselines.time_input``), as a time-indexed expert does.
     """
 
     rounds: int = 6
@@ -106,6 +109,7 @@ class DAggerSettings:
     net_arch: tuple[int, ...] = (256, 256)
     validation: int = 10
     start_scales: tuple[float, float] = (0.01, 0.1)
+    observe_time: bool = False
 
     def __post_init__(self) -> None:
         for name in ("gradient_steps", "batch_size", "episodes", "validation"):
@@ -211,7 +215,8 @@ def make_learner(env_id: str, env_kwargs: dict[str, Any], settings: DAggerSettin
     """A fresh ``PPO`` (Box actions) or ``HybridPPO`` (hybrid) model whose policy is trained.
 
     ``observations`` (N, d): the data whose mean and standard deviation (1 where it is 0)
-    standardize the policy's inputs (``Standardized``).
+    standardize the policy's inputs (``Standardized``); with ``settings.observe_time`` its last
+    column is the elapsed time of ``baselines.time_input``.
     """
     from stable_baselines3 import PPO
 
@@ -221,7 +226,10 @@ def make_learner(env_id: str, env_kwargs: dict[str, Any], settings: DAggerSettin
     statistics = {"mean": observations.mean(axis=0).tolist(),
                   "scale": np.where(std > 1e-6, std, 1.0).tolist()}  # fmt: skip
     model_class = HybridPPO if is_hybrid(env_id) else PPO
-    return model_class("MlpPolicy", gym.make(env_id, **env_kwargs), seed=seed, device="cpu",
+    env = gym.make(env_id, **env_kwargs)
+    if settings.observe_time:
+        env = time_aware(env)
+    return model_class("MlpPolicy", env, seed=seed, device="cpu",
                        learning_rate=settings.learning_rate,
                        policy_kwargs={"net_arch": list(settings.net_arch),
                                       "features_extractor_class": Standardized,
@@ -242,18 +250,23 @@ class _Labels:
 
 
 def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, learner: Any,
-                  beta: float, seed: int, rng: np.random.Generator, labels: _Labels) -> bool:
+                  beta: float, seed: int, rng: np.random.Generator, labels: _Labels,
+                  observe_time: bool = False) -> bool:  # fmt: skip
     """One episode of the beta-mixture from ``reset(seed=seed)``, every state labelled.
 
     At each step the expert is called (its action is the label); the action played is the
     expert's with probability ``beta`` and the learner's deterministic one otherwise.
-    ``env_kwargs`` include the start noise. Returns whether the episode ended at the goal.
+    ``env_kwargs`` include the start noise. The learner's inputs (the labelled data) are the
+    observations, with the elapsed time appended if ``observe_time``. Returns whether the
+    episode ended at the goal.
     """
     hybrid = is_hybrid(env_id)
     env = gym.make(env_id, **env_kwargs)
     policy = expert.make_policy(env)
+    limit = max_steps(env)
     observation, _ = env.reset(seed=seed)
-    done, info = False, {}
+    done, steps = False, 0
+    info: dict[str, Any] = {}
     episode: dict[str, Any] = {"seed": seed, "observations": [observation], "actions": [],
                                "rewards": [], "terminations": [], "truncations": []}
     while not done:
@@ -262,12 +275,15 @@ def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, l
         labels.cpu_s += time.process_time() - clock
         label = expert_label(action, hybrid)
         labels.calls += 1
-        labels.observations.append(np.asarray(observation, dtype=np.float32))
+        learner_input = (with_time(observation, steps, limit) if observe_time
+                         else np.asarray(observation, dtype=np.float32))  # fmt: skip
+        labels.observations.append(learner_input)
         labels.actions.append(label)
+        steps += 1
         if rng.random() < beta:
             flat = label
         else:
-            flat = learner.policy.predict(observation, deterministic=True)[0]
+            flat = learner.policy.predict(learner_input, deterministic=True)[0]
             if hasattr(policy, "applied"):  # an expert whose state follows the torques played
                 policy.applied(flat)
         observation, reward, terminated, truncated, info = env.step(native_action(flat, hybrid))
@@ -314,9 +330,16 @@ def fit(policy: Any, observations: np.ndarray, actions: np.ndarray, settings: DA
     return imitation_loss(policy, observations, actions)
 
 
-def learner_policy(model: Any) -> Callable[[Any], Callable[[Any], Any]]:
-    """The ``Controller.make_policy`` of a model: its deterministic ``predict``."""
-    return lambda _env: lambda observation: model.predict(observation, deterministic=True)[0]
+def learner_policy(model: Any, observe_time: bool = False
+                   ) -> Callable[[Any], Callable[[Any], Any]]:  # fmt: skip
+    """The ``Controller.make_policy`` of a model: its deterministic ``predict``.
+
+    With ``observe_time`` the model sees the elapsed time (``time_input.counting_policy``).
+    """
+    def act(observation: Any) -> Any:
+        return model.predict(observation, deterministic=True)[0]
+
+    return lambda env: counting_policy(act, env) if observe_time else act
 
 
 def validation_cost(episodes: list[Any], objective: str) -> float | None:
@@ -377,7 +400,7 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             reached = [play_labelled(env_id, {**env_kwargs, "reset_noise_scale": scale}, controller,
-                                     model, beta, reset_seed, rng, labels)
+                                     model, beta, reset_seed, rng, labels, settings.observe_time)
                        for scale, reset_seed in starts + perturbed_starts(rng, settings.episodes,
                                                                            settings.start_scales)]
             if model is None:
@@ -385,7 +408,7 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
                                      np.array(labels.observations))  # fmt: skip
             losses.append(fit(model.policy, np.array(labels.observations),
                               np.array(labels.actions), settings, rng))  # fmt: skip
-            episodes = [play(env_id, learner_policy(model), reset_seed,
+            episodes = [play(env_id, learner_policy(model, settings.observe_time), reset_seed,
                              **{**env_kwargs, "reset_noise_scale": scale})
                         for scale, reset_seed in validation]  # fmt: skip
         validated.append(float(np.mean([episode.is_success for episode in episodes])))
@@ -485,7 +508,8 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
     output.mkdir(parents=True, exist_ok=True)
     stem = run_name(env_id, objective, ALGO, seed)
     model.save(output / f"{stem}.zip")
-    evaluation: PolicyEvaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed + 10_000)
+    evaluation: PolicyEvaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed + 10_000,
+                                            settings.observe_time)  # fmt: skip
     steps = record.expert_calls
     episodes = (settings.rounds + 1) * settings.episodes + 1
     training = TrainingRecord(
@@ -498,7 +522,8 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
         command=f"mdi-envs distill {env_id} --expert {expert} --seeds {seed} --rounds "
                 f"{settings.rounds} --episodes {settings.episodes} "
                 f"--gradient-steps {settings.gradient_steps} --start-scales "
-                f"{settings.start_scales[0]} {settings.start_scales[1]}")
+                f"{settings.start_scales[0]} {settings.start_scales[1]}"
+                + (" --observe-time" if settings.observe_time else ""))
     data = {**asdict(training), "distillation": asdict(record)}
     (output / f"{stem}.json").write_text(json.dumps(data, indent=2, default=str) + "\n")
     return output / f"{stem}.zip"
@@ -524,6 +549,9 @@ def add_distill_parser(subparsers: Any) -> argparse.ArgumentParser:
                         metavar=("LOW", "HIGH"),
                         help="range of the perturbed starts' noise half-width, drawn "
                              "log-uniformly (default: %(default)s)")
+    parser.add_argument("--observe-time", action="store_true",
+                        help="the learner also sees the normalized elapsed time (for a "
+                             "time-indexed expert)")
     parser.add_argument("--output", type=Path, default=DEFAULT_OUTPUT)
     parser.add_argument("--dataset", action="store_true",
                         help="also write each seed's labelled episodes as the Minari dataset "
@@ -543,7 +571,8 @@ def run_distill(args: argparse.Namespace) -> int:
     try:
         settings = DAggerSettings(rounds=args.rounds, episodes=args.episodes,
                                    gradient_steps=args.gradient_steps,
-                                   start_scales=tuple(args.start_scales))
+                                   start_scales=tuple(args.start_scales),
+                                   observe_time=args.observe_time)
         for seed in args.seeds:
             stem = run_name(args.env_id, OBJECTIVES.get(args.env_id, ("",))[0], ALGO, seed)
             if (args.output / f"{stem}.json").exists():

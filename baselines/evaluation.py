@@ -216,11 +216,15 @@ def shipped_algorithms(env_id: str, objective: str, directory: Path = TRAINED_DI
 def load_policy(config_path: Path) -> Controller:
     """A trained policy (deterministic ``predict``) as a ``Controller`` labelled by its algo.
 
+    A policy trained with ``observe_time`` in its ``algo_kwargs`` (a distilled one) is given the
+    elapsed time as well (``baselines.time_input.counting_policy``).
+
     Sets torch to one thread: a batch of one observation through a small network only loses
     to the threads' synchronisation (on a loaded machine, tens of times the one-thread time).
     """
     import torch
 
+    from baselines.time_input import counting_policy
     from baselines.train import load_trained, read_training
 
     torch.set_num_threads(1)
@@ -230,9 +234,13 @@ def load_policy(config_path: Path) -> Controller:
     def act(obs: Any) -> Any:
         return model.predict(obs, deterministic=True)[0]
 
+    def make_policy(env: gym.Env[Any, Any]) -> Policy:
+        return counting_policy(act, env) if observe_time else act
+
+    observe_time = bool(record.algo_kwargs.get("observe_time", False))
     training = Training(Path(config_path).stem, record.seed, record.commit,
                         record.num_timesteps, record.num_envs)  # fmt: skip
-    return Controller(record.algo, lambda _env: act, dict(record.env_kwargs), training)
+    return Controller(record.algo, make_policy, dict(record.env_kwargs), training)
 
 
 def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: int,

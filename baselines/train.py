@@ -328,16 +328,22 @@ def train(
 
 
 def evaluate(model: Any, env_id: str, env_kwargs: dict[str, Any], episodes: int,
-             seed: int) -> PolicyEvaluation:  # fmt: skip
-    """SB3's ``evaluate_policy`` (deterministic) on ``gym.make`` from ``reset(seed=seed)``."""
+             seed: int, observe_time: bool = False) -> PolicyEvaluation:  # fmt: skip
+    """SB3's ``evaluate_policy`` (deterministic) on ``gym.make`` from ``reset(seed=seed)``.
+
+    ``observe_time``: the model sees the elapsed time (``baselines.time_input.time_aware``).
+    """
     from stable_baselines3.common.evaluation import evaluate_policy
     from stable_baselines3.common.monitor import Monitor
+
+    from baselines.time_input import time_aware
 
     if episodes <= 0:
         return PolicyEvaluation(episodes, seed)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        env = Monitor(gym.make(env_id, **env_kwargs))
+        env = gym.make(env_id, **env_kwargs)
+        env = Monitor(time_aware(env) if observe_time else env)
     env.reset(seed=seed)
     finals: list[dict[str, Any]] = []
 

@@ -109,6 +109,33 @@ def test_the_distilled_manipulator_loads_and_plays_as_a_trained_row(tmp_path: Pa
     assert brake in (0, 1) and torque.shape == (1,)
 
 
+def test_a_time_aware_learner_sees_the_step_count_in_training_and_when_played(
+        tmp_path: Path) -> None:  # fmt: skip
+    expert = lqr_controller(MANIPULATOR_V1, "time")
+    assert expert is not None
+    labels = _Labels([], [])
+    kwargs = {**learner_env_kwargs(MANIPULATOR_V1, expert), "reset_noise_scale": 0.05}
+    play_labelled(MANIPULATOR_V1, kwargs, expert, None, 1.0, 2, np.random.default_rng(0), labels,
+                  observe_time=True)  # fmt: skip
+    inputs = np.array(labels.observations)
+    limit = gym.make(MANIPULATOR_V1, **kwargs).spec.max_episode_steps  # type: ignore[union-attr]
+    assert inputs.shape == (len(inputs), 8)
+    np.testing.assert_allclose(inputs[:, -1], np.arange(len(inputs)) / limit, atol=1e-7)
+
+    settings = DAggerSettings(rounds=0, episodes=1, gradient_steps=50, net_arch=(16,),
+                              validation=1, observe_time=True)  # fmt: skip
+    path = distill(MANIPULATOR_V1, "lqr", settings, seed=1, output=tmp_path, eval_episodes=1)
+    config = json.loads(path.with_suffix(".json").read_text())
+    assert config["algo_kwargs"]["observe_time"] and config["command"].endswith("--observe-time")
+    controller = load_policy(path.with_suffix(".json"))
+    env = gym.make(MANIPULATOR_V1, **controller.env_kwargs)
+    policy = controller.make_policy(env)
+    brake, torque = policy(env.reset(seed=0)[0])
+    assert brake in (0, 1) and torque.shape == (1,)
+    episode = play(MANIPULATOR_V1, controller.make_policy, 0, **controller.env_kwargs)
+    assert episode.num_steps > 0
+
+
 def test_the_hybrid_label_plays_exactly_the_experts_box_action() -> None:
     expert = lqr_controller(MANIPULATOR_V1, "time")
     assert expert is not None
