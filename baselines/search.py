@@ -304,10 +304,12 @@ def storage(url: str = DEFAULT_STORAGE) -> Any:
         Path(url.removeprefix("sqlite:///")).parent.mkdir(parents=True, exist_ok=True)
 
     def make() -> Any:
-        return optuna.storages.RDBStorage(
-            url, heartbeat_interval=60, grace_period=600,
-            heartbeat_stale_trial_callback=optuna.storages.RetryHeartbeatStaleTrialCallback(
-                max_retry=1))
+        with warnings.catch_warnings():  # heartbeats are marked experimental in Optuna
+            warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
+            return optuna.storages.RDBStorage(
+                url, heartbeat_interval=60, grace_period=600,
+                heartbeat_stale_trial_callback=optuna.storages.RetryHeartbeatStaleTrialCallback(
+                    max_retry=1))
 
     for attempt in range(2):  # workers started together race to create a new storage's tables
         try:
@@ -317,16 +319,26 @@ def storage(url: str = DEFAULT_STORAGE) -> Any:
     return make()
 
 
-def load_study(name: str, url: str = DEFAULT_STORAGE) -> Any:
-    """The study ``name`` (created if new): maximize the score, TPE sampler, median pruner."""
+def load_study(name: str, url: str = DEFAULT_STORAGE, create: bool = True) -> Any:
+    """The study ``name``: maximize the score, TPE sampler, median pruner.
+
+    Raises:
+        KeyError: an unknown name, or (``create`` False) a study not yet in the storage.
+    """
     import optuna
 
     if name not in SEARCHES:
         raise KeyError(f"unknown study {name!r}; known: {', '.join(SEARCHES)}")
-    return optuna.create_study(
-        study_name=name, storage=storage(url), direction="maximize", load_if_exists=True,
-        sampler=optuna.samplers.TPESampler(n_startup_trials=10, multivariate=True),
-        pruner=optuna.pruners.MedianPruner(n_startup_trials=5, n_warmup_steps=1))
+    rdb = storage(url)
+    sampler = optuna.samplers.TPESampler(n_startup_trials=10, multivariate=True)
+    pruner = optuna.pruners.MedianPruner(n_startup_trials=5, n_warmup_steps=1)
+    if create:
+        return optuna.create_study(study_name=name, storage=rdb, direction="maximize",
+                                   load_if_exists=True, sampler=sampler, pruner=pruner)
+    if name not in optuna.get_all_study_names(rdb):
+        raise KeyError(f"study {name!r} is not in {url} yet; "
+                       f"`python -m baselines.search run {name}` starts it")
+    return optuna.load_study(study_name=name, storage=rdb, sampler=sampler, pruner=pruner)
 
 
 def make_objective(search: Search, timesteps: int | None = None) -> Callable[[Any], float]:
@@ -389,7 +401,7 @@ def plot(name: str, url: str = DEFAULT_STORAGE, output: Path = SEARCH_DIR) -> li
     import optuna
     from optuna.visualization import matplotlib as optuna_plots
 
-    study = load_study(name, url)
+    study = load_study(name, url, create=False)
     finished = study.get_trials(states=(optuna.trial.TrialState.COMPLETE,))
     plots = {"history": optuna_plots.plot_optimization_history,
              "intermediate": optuna_plots.plot_intermediate_values}
@@ -414,7 +426,7 @@ def summary(name: str, url: str = DEFAULT_STORAGE) -> dict[str, Any]:
     """Trial counts by state, the best trial's score, evaluation and arguments."""
     import optuna
 
-    study = load_study(name, url)
+    study = load_study(name, url, create=False)
     counts: dict[str, int] = {}
     for trial in study.trials:
         counts[trial.state.name] = counts.get(trial.state.name, 0) + 1
@@ -433,7 +445,7 @@ def best_arguments(name: str, url: str = DEFAULT_STORAGE) -> dict[str, Any]:
     """The SB3 arguments of the study's best finished trial."""
     import optuna
 
-    study = load_study(name, url)
+    study = load_study(name, url, create=False)
     return SAMPLERS[SEARCHES[name].algo](optuna.trial.FixedTrial(study.best_trial.params))
 
 
@@ -492,12 +504,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.command == "run":
         run(args.study, args.storage, args.n_trials, args.timeout, args.timesteps)
-    elif args.command == "plot":
-        for path in plot(args.study, args.storage):
-            print(path)
-    elif args.command == "write-yaml":
-        print(write_yaml(args.study, args.storage))
-    print(json.dumps(summary(args.study, args.storage), indent=2, default=str))
+    try:
+        if args.command == "plot":
+            for path in plot(args.study, args.storage):
+                print(path)
+        if args.command == "write-yaml":
+            print(write_yaml(args.study, args.storage))
+        print(json.dumps(summary(args.study, args.storage), indent=2, default=str))
+    except KeyError as error:
+        raise SystemExit(f"baselines.search: {error.args[0]}") from error
     return 0
 
 

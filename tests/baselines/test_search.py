@@ -102,3 +102,16 @@ def test_study_resumes_records_its_trials_and_writes_the_best_into_yaml(tmp_path
     assert {k: v for k, v in after.items() if k != "mdi_envs/DiffDriveRobot-v1"} == {
         k: v for k, v in before.items() if k != "mdi_envs/DiffDriveRobot-v1"}
     assert path.read_text().startswith("#")  # the file's comments stay
+
+
+def test_reading_a_study_that_was_never_run_is_an_error_and_creates_nothing(
+        tmp_path: Path) -> None:  # fmt: skip
+    import optuna
+
+    url = f"sqlite:///{tmp_path / 'studies.db'}"
+    for read in (search.summary, search.best_arguments, search.plot):
+        with pytest.raises(KeyError, match="is not in .* yet"):
+            read("DiffDriveRobot-v1_sac", url)
+    assert optuna.get_all_study_names(search.storage(url)) == []
+    with pytest.raises(SystemExit, match="baselines.search run DiffDriveRobot-v1_sac"):
+        search.main(["summary", "DiffDriveRobot-v1_sac", "--storage", url])
