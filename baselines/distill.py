@@ -263,7 +263,7 @@ def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, l
     hybrid = is_hybrid(env_id)
     env = gym.make(env_id, **env_kwargs)
     policy = expert.make_policy(env)
-    limit = max_steps(env)
+    limit = max_steps(env) if observe_time else 0
     observation, _ = env.reset(seed=seed)
     done, steps = False, 0
     info: dict[str, Any] = {}
