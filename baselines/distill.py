@@ -65,9 +65,9 @@ import torch as th
 from stable_baselines3.common.torch_layers import FlattenExtractor
 
 from baselines.datasets import TASKS, dataset_id
-from baselines.evaluation import DISTILLED_DIR, OBJECTIVES, Controller, play
+from baselines.evaluation import DISTILLED_DIR, OBJECTIVES, Controller, model_policy, play
 from baselines.model_based import EXPERTS
-from baselines.time_input import counting_policy, max_steps, time_aware, with_time
+from baselines.time_input import max_steps, time_aware, with_time
 from mdi_envs.provenance import git_commit
 
 FIRST_TRAINING_SEED = 1_000_000
@@ -330,18 +330,6 @@ def fit(policy: Any, observations: np.ndarray, actions: np.ndarray, settings: DA
     return imitation_loss(policy, observations, actions)
 
 
-def learner_policy(model: Any, observe_time: bool = False
-                   ) -> Callable[[Any], Callable[[Any], Any]]:  # fmt: skip
-    """The ``Controller.make_policy`` of a model: its deterministic ``predict``.
-
-    With ``observe_time`` the model sees the elapsed time (``time_input.counting_policy``).
-    """
-    def act(observation: Any) -> Any:
-        return model.predict(observation, deterministic=True)[0]
-
-    return lambda env: counting_policy(act, env) if observe_time else act
-
-
 def validation_cost(episodes: list[Any], objective: str) -> float | None:
     """Mean time [s] (``objective`` "time") or effort over the successful ``episodes``."""
     costs = [episode.elapsed_time if objective == "time" else episode.effort
@@ -408,7 +396,7 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
                                      np.array(labels.observations))  # fmt: skip
             losses.append(fit(model.policy, np.array(labels.observations),
                               np.array(labels.actions), settings, rng))  # fmt: skip
-            episodes = [play(env_id, learner_policy(model, settings.observe_time), reset_seed,
+            episodes = [play(env_id, model_policy(model, settings.observe_time), reset_seed,
                              **{**env_kwargs, "reset_noise_scale": scale})
                         for scale, reset_seed in validation]  # fmt: skip
         validated.append(float(np.mean([episode.is_success for episode in episodes])))
@@ -591,7 +579,7 @@ def run_distill(args: argparse.Namespace) -> int:
 __all__ = [
     "ALGO", "DEFAULT_OUTPUT", "FIRST_TRAINING_SEED", "DAgger",
     "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill",
-    "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs", "learner_policy",
+    "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs",
     "make_learner", "native_action", "perturbed_starts", "play_labelled", "validation_cost",
     "validation_rank", "write_labels",
 ]

@@ -213,34 +213,42 @@ def shipped_algorithms(env_id: str, objective: str, directory: Path = TRAINED_DI
     return set(group_by_algorithm(shipped_policies(env_id, objective, directory)))
 
 
+def model_policy(model: Any, observe_time: bool = False
+                 ) -> Callable[[gym.Env[Any, Any]], Policy]:  # fmt: skip
+    """The ``Controller.make_policy`` of an SB3 model: its deterministic ``predict``.
+
+    With ``observe_time`` the model is given the elapsed time as well
+    (``baselines.time_input.counting_policy``).
+    """
+    from baselines.time_input import counting_policy
+
+    def act(observation: Any) -> Any:
+        return model.predict(observation, deterministic=True)[0]
+
+    return lambda env: counting_policy(act, env) if observe_time else act
+
+
 def load_policy(config_path: Path) -> Controller:
-    """A trained policy (deterministic ``predict``) as a ``Controller`` labelled by its algo.
+    """A trained policy (``model_policy``) as a ``Controller`` labelled by its algo.
 
     A policy trained with ``observe_time`` in its ``algo_kwargs`` (a distilled one) is given the
-    elapsed time as well (``baselines.time_input.counting_policy``).
+    elapsed time as well.
 
     Sets torch to one thread: a batch of one observation through a small network only loses
     to the threads' synchronisation (on a loaded machine, tens of times the one-thread time).
     """
     import torch
 
-    from baselines.time_input import counting_policy
     from baselines.train import load_trained, read_training
 
     torch.set_num_threads(1)
     record = read_training(config_path)
     model = load_trained(record.algo, Path(config_path).with_suffix(".zip"))
-
-    def act(obs: Any) -> Any:
-        return model.predict(obs, deterministic=True)[0]
-
-    def make_policy(env: gym.Env[Any, Any]) -> Policy:
-        return counting_policy(act, env) if observe_time else act
-
     observe_time = bool(record.algo_kwargs.get("observe_time", False))
     training = Training(Path(config_path).stem, record.seed, record.commit,
                         record.num_timesteps, record.num_envs)  # fmt: skip
-    return Controller(record.algo, make_policy, dict(record.env_kwargs), training)
+    return Controller(record.algo, model_policy(model, observe_time), dict(record.env_kwargs),
+                      training)  # fmt: skip
 
 
 def play(env_id: str, make_policy: Callable[[gym.Env[Any, Any]], Policy], seed: int,
@@ -505,7 +513,7 @@ __all__ = [
     "REFERENCE_NAMES", "SCALES", "SCHEDULE_KEYS", "SCORES", "TRAINED_DIR", "DISTILLED_DIR",
     "Controller",
     "ControllerFactory", "LoggedEpisode", "aggregate", "append_log", "controller_rows",
-    "evaluate", "group_by_algorithm", "load_policy", "merge", "optimal_controller",
+    "evaluate", "group_by_algorithm", "load_policy", "merge", "model_policy", "optimal_controller",
     "play", "read_log", "reference_controller", "reference_effort", "register_controller",
     "registered_controllers", "shipped_algorithms", "shipped_policies",
 ]
