@@ -50,6 +50,7 @@ from baselines.records import (
     Training,
 )
 from baselines.records import Trajectory as TrajectoryRecord
+from baselines.time_input import counting_policy
 from mdi_envs.mechanics.models.blockable_manipulator import BlockableManipulatorParameters
 from mdi_envs.mechanics.models.diff_drive import DiffDriveParameters
 from mdi_envs.provenance import git_commit
@@ -220,8 +221,6 @@ def model_policy(model: Any, observe_time: bool = False
     With ``observe_time`` the model is given the elapsed time as well
     (``baselines.time_input.counting_policy``).
     """
-    from baselines.time_input import counting_policy
-
     def act(observation: Any) -> Any:
         return model.predict(observation, deterministic=True)[0]
 
