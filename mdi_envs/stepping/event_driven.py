@@ -208,7 +208,7 @@ class Event(NamedTuple):
 
 
 @dataclass(frozen=True)
-class _Segment:
+class Segment:
     """A smooth phase on (t0, t1]: dense output of the reduced state and its map to (q, u)."""
 
     t0: float
@@ -245,7 +245,7 @@ class Trajectory:
     t_end: float
     status: str
     num_rhs_evals: int
-    _segments: tuple[_Segment, ...] = field(repr=False)
+    _segments: tuple[Segment, ...] = field(repr=False)
 
     def evaluate(self, times: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The state at arbitrary times, from the dense output.
@@ -271,7 +271,7 @@ class Trajectory:
         return [event for event in self.events if event.kind == kind]
 
 
-def _sample(start: Event, segments: tuple[_Segment, ...], t_end: float, times: ArrayLike
+def _sample(start: Event, segments: tuple[Segment, ...], t_end: float, times: ArrayLike
             ) -> tuple[FloatArray, FloatArray]:
     """(q, u-) at ``times`` from the dense output (see ``Trajectory.evaluate``)."""
     times = np.atleast_1d(np.asarray(times, dtype=np.float64))
@@ -562,7 +562,7 @@ class _Run:
         self.ig = integrator
         self.inputs, self.brakes = inputs, brakes
         self.events: list[Event] = []
-        self.segments: list[_Segment] = []
+        self.segments: list[Segment] = []
         self.status = STATUS_COMPLETED
         self.num_rhs_evals = 0
         self.last_impact = np.full(integrator._c, -np.inf)
@@ -741,7 +741,7 @@ class _Run:
                 raise RuntimeError(f"solve_ivp failed at t={sol.t[-1]}: {sol.message}")
             self.num_rhs_evals += sol.nfev
             t_new = float(sol.t[-1])
-            self.segments.append(_Segment(self.t, t_new, sol.sol, phase.q_a, phase.N))
+            self.segments.append(Segment(self.t, t_new, sol.sol, phase.q_a, phase.N))
             self.q = phase.q_a + phase.N @ sol.y[:d, -1]
             self.u = phase.N @ sol.y[d:, -1]
             self.t = t_new
