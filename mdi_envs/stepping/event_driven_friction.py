@@ -484,10 +484,19 @@ class _FrictionRun:
         self._record(EVENT_INPUT_SWITCH, -1, self.u)
         self._decide(frozenset())
 
-    def _phase(self) -> tuple[Callable[[float, FloatArray], FloatArray],
-                              list[Callable[[float, FloatArray], float]], list[tuple[str, int]]]:
-        """The current phase's right-hand side, its event functions and their labels."""
-        ig, n, inputs = self.ig, self.ig._n, self.inputs
+    def _phase(self, t_stop: float) -> tuple[Callable[[float, FloatArray], FloatArray],
+                                             list[Callable[[float, FloatArray], float]],
+                                             list[tuple[str, int]]]:
+        """The right-hand side of a phase ending by t_stop, its event functions and labels.
+
+        The inputs are their left limits at t_stop (a switch there acts on the next phase).
+        """
+        ig, n = self.ig, self.ig._n
+        last = float(np.nextafter(t_stop, -np.inf))
+
+        def inputs(t: float) -> FloatArray:
+            return self.inputs(min(t, last))
+
         sliding, armed = dict(self.sliding), set(self.armed)
         stuck = [i for i in range(ig._c) if i not in sliding]
 
@@ -529,7 +538,7 @@ class _FrictionRun:
         ig, n = self.ig, self.ig._n
         while self.t < t_stop and self.status == STATUS_COMPLETED:
             stuck = frozenset(i for i in range(ig._c) if i not in self.sliding)
-            rhs, events, labels = self._phase()
+            rhs, events, labels = self._phase(t_stop)
             solution = solve_ivp(rhs, (self.t, t_stop), np.concatenate([self.q, self.u]),
                                  method=ig.method, rtol=ig.rtol, atol=ig.atol,
                                  dense_output=True, events=events or None)
