@@ -373,10 +373,12 @@ def references_page() -> None:
                   if not p.stem.endswith("_refinement")]
     if continuous:
         lines += ["## Continuous-time optima", "",
-                  "The mode sequence of a reference with its switching times and t_f optimized "
-                  "against the event-driven integrator (`optimal/continuous/NAME.json`; "
-                  "[method](../guide/polish.md)).", "",
-                  table([{"reference": c["name"], "continuous-time t_f [s]": c.get("final_time"),
+                  "The mode sequence of a reference with its switching times and t_f (and the "
+                  "robot's controls within its phases) optimized in continuous time "
+                  "(`optimal/continuous/NAME.json`; [method](../guide/polish.md)). Cost: t_f "
+                  "[s] or the effort integral.", "",
+                  table([{"reference": c["name"],
+                          "continuous-time cost": c.get("cost", c.get("final_time")),
                           "h-discrete optimum": c.get("discrete_cost"),
                           "intervals N": c.get("discrete_num_intervals"),
                           "relative difference": c.get("relative_difference"),
@@ -432,6 +434,11 @@ def refinement_section(study: dict[str, Any]) -> list[str]:
                 "projected on the grid, then mode-searched for at most the given rounds "
                 "([method](../guide/polish.md#refinement-toward-the-continuous-optimum)). The "
                 "distance is to the continuous optimum.", "", table(rows, floatfmt=".6g"), ""]
+    continuous_path = ROOT / "optimal" / "continuous" / f"{name}.json"
+    continuous = load(continuous_path)["cost"] if continuous_path.exists() else None
+    if continuous is not None:
+        for row, level in zip(rows, study_table(study), strict=True):
+            row["above the continuous optimum"] = level["cost"] / continuous - 1.0
     fit = study["extrapolation"]
     monotone = math.isfinite(fit["value"])
     before = (f"the three levels before give {fit['previous']:.7g} (uncertainty "
@@ -443,10 +450,15 @@ def refinement_section(study: dict[str, Any]) -> list[str]:
                 f"p = {fit['order']:.3f}; {before}. The distance is to c." if monotone else
                 f"The three finest levels (N = {', '.join(map(str, fit['levels']))}) do not "
                 "change monotonically: no extrapolated limit, no distance.")
+    against = (f" The last column compares each level with the continuous-time optimum of "
+               f"the reference's mode sequence ({continuous:.7g}, `optimal/continuous/"
+               f"{name}.json`), whose switching times differ from the fixed pattern's."
+               if continuous is not None else "")
     return [f"## Refinement with the pattern fixed: {name}", "",
             command + "solved with the stick-slip phases of the shipped reference's finest "
             "refinement level projected on the grid and fixed "
-            "([method](../guide/polish.md#robot-extrapolated-limits)). " + estimate, "",
+            "([method](../guide/polish.md#robot-extrapolated-limits)). " + estimate + against,
+            "",
             table(rows, floatfmt=".7g"), ""]
 
 
