@@ -72,6 +72,8 @@ from mdi_envs.stepping.event_driven import (
 EVENT_STICK = "stick"
 EVENT_SLIP = "slip"
 STATUS_UNDECIDED = "undecided_mode"  # no candidate of the acceleration-level law is consistent
+GRAZING_RATE = 1e-9  # [m/s^2] a slip acceleration this small is zero (see ``_onset``)
+EDGE_FORCE = 1e-6  # a stuck contact within this x the total static load of its cone's edge
 _TOGETHER = 10.0  # at a stop, other slides with |gamma| <= this x slip_tolerance stop as well
 
 
@@ -230,36 +232,39 @@ class EventDrivenFrictionIntegrator:
         x = Vt[:rank].T @ ((U[:, :rank].T @ b) / s[:rank])
         return x[:n], x[n:], Vt[rank:, n:].T
 
-    def stick_margin(self, forces: FloatArray, null: FloatArray, sticking: list[int]) -> float:
-        """Stick margin m = max over the free split of min_{i in S} (mu_i N_i - |F_i|) [N].
+    def contact_margins(self, forces: FloatArray, null: FloatArray, sticking: list[int]
+                        ) -> dict[int, float]:
+        """Per sticking contact, mu_i N_i - |F_i| [N] at the split that maximizes the smallest.
 
         Raises:
             NotImplementedError: a null space of dimension > 1, or one that changes the loads.
         """
-        if not sticking:
-            return math.inf
         loads = self.n0 + self.k @ forces
-        if null.shape[1] == 0:
-            return min(self.mu[i] * loads[i] - math.hypot(*forces[2 * i: 2 * i + 2])
-                       for i in sticking)
+
+        def margins(xi: float) -> dict[int, float]:
+            moved = forces + xi * null[:, 0] if null.shape[1] else forces
+            return {i: self.mu[i] * loads[i] - math.hypot(*moved[2 * i: 2 * i + 2])
+                    for i in sticking}
+
+        if not sticking or null.shape[1] == 0:
+            return margins(0.0)
         if null.shape[1] > 1 or np.abs(self.k @ null).max() > 1e-9:
             raise NotImplementedError("stick margin: a force null space of dimension > 1 or one "
                                       "that changes the normal loads")
         z = null[:, 0]
-
-        def margin(xi: float) -> float:
-            return min(self.mu[i] * loads[i]
-                       - math.hypot(*(forces[2 * i: 2 * i + 2] + xi * z[2 * i: 2 * i + 2]))
-                       for i in sticking)
-
         moving = [np.hypot(*z[2 * i: 2 * i + 2]) for i in sticking]
         if max(moving) < 1e-12:
-            return margin(0.0)
+            return margins(0.0)
         reach = max(np.hypot(*forces[2 * i: 2 * i + 2]) + self.mu[i] * abs(loads[i])
                     for i in sticking) / min(m for m in moving if m >= 1e-12)
-        best = minimize_scalar(lambda xi: -margin(xi), bounds=(-reach, reach), method="bounded",
-                               options={"xatol": 1e-14 * reach, "maxiter": 500})
-        return max(margin(float(best.x)), margin(0.0))
+        best = minimize_scalar(lambda xi: -min(margins(xi).values()), bounds=(-reach, reach),
+                               method="bounded", options={"xatol": 1e-14 * reach,
+                                                          "maxiter": 500})
+        return max(margins(float(best.x)), margins(0.0), key=lambda m: min(m.values()))
+
+    def stick_margin(self, forces: FloatArray, null: FloatArray, sticking: list[int]) -> float:
+        """Stick margin m = max over the free split of min_{i in S} (mu_i N_i - |F_i|) [N]."""
+        return min(self.contact_margins(forces, null, sticking).values(), default=math.inf)
 
     def slip_rates(self, q: FloatArray, u: FloatArray, accelerations: FloatArray) -> FloatArray:
         """Slip accelerations gamma' = W u' + W' u, (c, 2) [m/s^2]."""
@@ -282,26 +287,44 @@ class EventDrivenFrictionIntegrator:
             q, u, tau: state and inputs at the event.
             sliding: the contacts that keep sliding, with their slip directions.
             zero_slip: the contacts whose mode is decided.
-            excluded_stuck: if not empty, candidates in which all of these stick are skipped.
+            excluded_stuck: if not empty (after a stick-margin event), candidates in which all
+                of these stick are skipped, and those whose starting slides are the contacts at
+                their cone's edge are tried first.
 
         Returns:
             The new sliding contacts with their directions (the kept ones and the starting
             ones), or None when no candidate is consistent.
         """
-        for size in range(len(zero_slip) + 1):
-            for starting in itertools.combinations(zero_slip, size):
-                stuck = [i for i in zero_slip if i not in starting]
-                if excluded_stuck and excluded_stuck.issubset(stuck):
-                    continue
-                found = self._onset(q, u, tau, sliding, list(starting), stuck)
-                if found is not None:
-                    return found
+        candidates = [starting for size in range(len(zero_slip) + 1)
+                      for starting in itertools.combinations(zero_slip, size)]
+        if excluded_stuck:  # the contacts at their cone's edge first, all of them together
+            _, forces, null = self.accelerations(q, u, tau, sliding)
+            margins = self.contact_margins(forces, null, sorted(excluded_stuck))
+            edge = [i for i, margin in margins.items() if margin <= EDGE_FORCE * self.n0.sum()]
+            first = [starting for size in range(len(edge), 0, -1)
+                     for starting in itertools.combinations(edge, size)]
+            candidates = first + [s for s in candidates if s not in first]
+        for starting in candidates:
+            stuck = [i for i in zero_slip if i not in starting]
+            if excluded_stuck and excluded_stuck.issubset(stuck):
+                continue
+            found = self._onset(q, u, tau, sliding, list(starting), stuck,
+                                grazing=bool(excluded_stuck))
+            if found is not None:
+                return found
         return None
 
     def _onset(self, q: FloatArray, u: FloatArray, tau: FloatArray,
-               sliding: dict[int, FloatArray], starting: list[int], stuck: list[int]
-               ) -> dict[int, FloatArray] | None:
-        """The directions of the starting slides if this candidate is consistent, else None."""
+               sliding: dict[int, FloatArray], starting: list[int], stuck: list[int],
+               grazing: bool = False) -> dict[int, FloatArray] | None:
+        """The directions of the starting slides if this candidate is consistent, else None.
+
+        ``grazing``: the event is a stick margin reaching 0, where the force of a contact that
+        starts to slide is on its cone's edge and its slip acceleration lambda_i d_i is 0 at
+        that instant (the slip grows as t^2); lambda_i = 0 is then accepted, and the first
+        direction tried, opposite to the stuck force, is the one it leaves in.
+        """
+        lowest = -GRAZING_RATE if grazing else GRAZING_RATE
         def modes(angles: FloatArray) -> dict[int, FloatArray]:
             return {**sliding, **{i: np.array([math.cos(a), math.sin(a)])
                                   for i, a in zip(starting, angles, strict=True)}}
@@ -313,7 +336,7 @@ class EventDrivenFrictionIntegrator:
             for i in starting:
                 along = float(chosen[i] @ rates[i])
                 across = abs(chosen[i][0] * rates[i][1] - chosen[i][1] * rates[i][0])
-                if along <= 1e-9 or across > 1e-8 * (1.0 + along):
+                if along <= lowest or across > 1e-8 * (1.0 + abs(along)):
                     return None
             if self.stick_margin(forces, null, stuck) < -self.force_tolerance:
                 return None

@@ -92,6 +92,48 @@ def test_modes_from_rest_follow_the_traction_limit(
         assert (np.hypot(*slips[i]) > 1e-4) == (kind == EVENT_SLIP)
 
 
+class _Ramp:
+    """Equal wheel torques rising linearly, 4 N m/s (inputs without switches)."""
+
+    switch_times = np.empty(0)
+
+    def __call__(self, t: float) -> np.ndarray:
+        return np.array([4.0 * t, 4.0 * t])
+
+
+def test_rising_torque_breaks_the_stick_then_the_wheels_loose_on_time(
+        integrator: EventDrivenFrictionIntegrator) -> None:
+    """A rising torque from rest: the stick breaks loose first, then the wheels.
+
+    Everything sticks until the stick's friction reaches its cone (the torques push the chassis
+    against it); the robot then rolls until the wheels' traction limit. Both are grazing onsets
+    (a stick margin reaching 0); closed forms from the load law: t1 = mu_s N_s0 r / (2 k) and
+    the torque tau* at which the wheel force F = (tau - J a / r) / r reaches mu_w N_w, with a
+    the rolling acceleration.
+    """
+    p = integrator._p
+    m, J, r, g = p.mass, p.wheel_inertia, p.wheel_radius, p.gravity
+    a, c, h = p.axle_offset, p.stick_offset, p.cm_height
+    mu_w, mu_s, span, rate = p.wheel_friction, p.stick_friction, a + c, 4.0
+    t1 = mu_s * a * m * g / span * r / 2.0 / rate
+    scale = 1.0 + 2.0 * J / (m * r * r) - mu_s * h / span
+    x1, x0 = 2.0 / r / scale, -mu_s * a * m * g / span / scale  # sum F_x = x1 tau + x0
+    slope = (1.0 - J * x1 / (m * r)) / r - mu_w * h * x1 / (2.0 * span)
+    offset = -J * x0 / (m * r * r) - mu_w * (c * m * g + h * x0) / (2.0 * span)
+    t_star = -offset / slope / rate
+
+    trajectory = integrator.simulate(np.zeros(5), np.zeros(5), 1.0, _Ramp())
+
+    assert trajectory.status == STATUS_COMPLETED
+    modes = _modes(trajectory)
+    assert [(kind, i) for _, kind, i in modes] == [
+        (EVENT_STICK, LEFT), (EVENT_STICK, RIGHT), (EVENT_STICK, STICK), (EVENT_SLIP, STICK),
+        (EVENT_SLIP, LEFT), (EVENT_SLIP, RIGHT)]
+    assert modes[3][0] == pytest.approx(t1, abs=1e-12)
+    assert modes[4][0] == pytest.approx(t_star, abs=1e-12)
+    assert modes[5][0] == modes[4][0]
+
+
 def test_friction_dissipates_until_rest(integrator: EventDrivenFrictionIntegrator) -> None:
     """A chassis thrown sideways and spinning, wheels still, no torque.
 
