@@ -5,10 +5,10 @@ phase). With that sequence fixed, the continuous-time problem is a smooth multi-
 control problem whose phase durations are free: each phase p has its own sticking set S_p,
 
     q' = u,   M u' = B tau + W(q)^T F,   N = N0 + K F,
-    W_i(q) u = 0,  |F_i| <= mu_i N_i                     (i in S_p, sticking),
+    W_i(q) u = 0,  |F_i| <= mu_i N_i,  N_i >= 0          (i in S_p, sticking),
     F_i = -mu_i N_i e_i,  gamma_i = s_i e_i,  s_i >= 0    (i not in S_p, sliding),
 
-N >= 0, |tau| <= tau_max (at the collocation points), from rest at the start pose to rest at the
+|tau| <= tau_max (at the collocation points), from rest at the start pose to rest at the
 goal pose, minimizing t_f or the effort integral of |tau|^2 at fixed t_f. A sliding contact's
 direction e_i = (cos a_i, sin a_i) and slip speed s_i are unknowns, so a slip that vanishes at a
 phase end (the start from rest, the final stop) is never divided by. It is solved by direct
@@ -250,7 +250,6 @@ def solve_phases(reference: Reference, phases: list[Phase], elements: int = 20,
                 guess_slip = (np.array(equations.contact_rows(guess_state[:n]))[tangent]
                               @ guess_state[n:]).reshape(c, 2)
                 guess_f = interpolate(guess_force, mid_times, t_point).reshape(c, 2)
-                opti.subject_to(loads >= 0.0)
                 for contact in range(c):
                     f = force[2 * contact: 2 * contact + 2]
                     if phase.sliding[contact]:
@@ -269,6 +268,7 @@ def solve_phases(reference: Reference, phases: list[Phase], elements: int = 20,
                                                          -guess_f[contact][0]))
                     else:
                         opti.subject_to(casadi.sumsqr(f) <= (mu[contact] * loads[contact]) ** 2)
+                        opti.subject_to(loads[contact] >= 0.0)
                 if rows:
                     Wall = equations.contact_rows(q)
                     opti.subject_to(casadi.vertcat(*[Wall[r, :] @ u for r in rows]) == 0.0)
