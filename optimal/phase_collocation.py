@@ -355,8 +355,8 @@ def solve_level(reference: Reference, elements: int, degree: int = 3) -> dict[st
 
     Returns:
         A plain-JSON record: elements, degree, cost, t_f, the phases [s], IPOPT's outcome, the
-        wall time [s], and the replay (status, the time reached, goal errors, whether they are
-        within the maneuver's tolerances, its stick and slip events).
+        wall time [s], the commit, and the replay (status, the time reached, goal errors,
+        whether they are within the maneuver's tolerances, its stick and slip events).
     """
     clock = time.perf_counter()
     result = solve_phases(reference, reference_phases(reference), elements, degree)
@@ -366,7 +366,7 @@ def solve_level(reference: Reference, elements: int, degree: int = 3) -> dict[st
     return {"elements": elements, "degree": degree, "cost": result.cost,
             "final_time": result.final_time, "phases": _phase_record(result),
             "converged": result.converged, "iterations": result.iterations,
-            "wall_time": wall_time,
+            "wall_time": wall_time, "commit": git_commit(),
             "replay": {"status": trajectory.status, "t_end": trajectory.t_end,
                        "goal_errors": errors, "reaches_goal": ok,
                        "events": [[e.t, e.kind, e.element] for e in trajectory.events
@@ -377,38 +377,44 @@ def polish_reference(name: str, elements: list[int], degree: int = 3,
                      directory: Path | None = None) -> dict[str, Any]:
     """Solve ``name``'s mode sequence at each number of elements; write ``NAME.json``.
 
-    The record's cost is the finest level's; with three levels of constant ratio it carries
-    their Richardson extrapolation (``optimal.convergence.richardson``) as ``extrapolation``.
+    Resumable: the record is written after each level, and a level already in it (same number
+    of elements and degree) is kept. Its cost is the finest level's; with three levels or more
+    it carries the Richardson extrapolation of the three finest
+    (``optimal.convergence.richardson``) as ``extrapolation``.
     """
     reference = load_reference(name)
-    folder = CONTINUOUS_DIR if directory is None else directory
-    levels = []
+    path = (CONTINUOUS_DIR if directory is None else directory) / f"{name}.json"
+    done = json.loads(path.read_text())["levels"] if path.exists() else []
+    levels = {level["elements"]: level for level in done if level["degree"] == degree}
+    record: dict[str, Any] = {}
     for count in sorted(elements):
-        level = solve_level(reference, count, degree)
-        levels.append(level)
-        print(f"K = {count}: cost {level['cost']:.7f}, converged {level['converged']}, replay "
-              f"{level['replay']['status']}, goal errors {level['replay']['goal_errors']}, "
-              f"{level['wall_time']:.0f} s", flush=True)
-    finest = levels[-1]
-    record: dict[str, Any] = {
-        "name": name, "cost": finest["cost"], "final_time": finest["final_time"],
-        "phases": finest["phases"], "goal_error": max(finest["replay"]["goal_errors"].values()),
-        "integrator": {"method": f"Gauss-Legendre collocation ({degree} points, "
-                                 f"{finest['elements']} elements per phase); replayed by "
-                                 "DOP853, event-driven", "rtol": 1e-11, "atol": 1e-12},
-        "levels": levels, "discrete_cost": reference.cost,
-        "discrete_num_intervals": reference.metadata["num_intervals"],
-        "relative_difference": finest["cost"] / reference.cost - 1.0,
-        "commit": git_commit()}
-    if len(levels) >= 3:
-        last = levels[-3:]
-        try:
-            record["extrapolation"] = richardson([lv["elements"] for lv in last],
-                                                 [lv["cost"] for lv in last])
-        except ValueError:
-            pass
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / f"{name}.json").write_text(json.dumps(record, indent=1) + "\n")
+        if count not in levels:
+            levels[count] = solve_level(reference, count, degree)
+            level = levels[count]
+            print(f"K = {count}: cost {level['cost']:.7f}, converged {level['converged']}, "
+                  f"replay {level['replay']['status']}, goal errors "
+                  f"{level['replay']['goal_errors']}, {level['wall_time']:.0f} s", flush=True)
+        ordered = [levels[k] for k in sorted(levels)]
+        finest = ordered[-1]
+        record = {
+            "name": name, "cost": finest["cost"], "final_time": finest["final_time"],
+            "phases": finest["phases"],
+            "goal_error": max(finest["replay"]["goal_errors"].values()),
+            "integrator": {"method": f"Gauss-Legendre collocation ({degree} points, "
+                                     f"{finest['elements']} elements per phase); replayed by "
+                                     "DOP853, event-driven", "rtol": 1e-11, "atol": 1e-12},
+            "levels": ordered, "discrete_cost": reference.cost,
+            "discrete_num_intervals": reference.metadata["num_intervals"],
+            "relative_difference": finest["cost"] / reference.cost - 1.0}
+        if len(ordered) >= 3:
+            last = ordered[-3:]
+            try:
+                record["extrapolation"] = richardson([lv["elements"] for lv in last],
+                                                     [lv["cost"] for lv in last])
+            except ValueError:  # the three finest levels are not in a constant ratio
+                pass
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(record, indent=1) + "\n")
     return record
 
 
