@@ -25,6 +25,7 @@ events and its final state against the goal.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import time
@@ -83,13 +84,19 @@ def reference_phases(reference: Reference, slip_threshold: float = 1e-6) -> list
     return phases
 
 
+@functools.cache
+def _gauss_points(degree: int) -> FloatArray:
+    """The ``degree`` Gauss-Legendre points in (0, 1), increasing."""
+    return (np.polynomial.legendre.leggauss(degree)[0] + 1.0) / 2.0
+
+
 def _legendre_scheme(degree: int) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Gauss-Legendre points tau_j in (0, 1) and the Lagrange matrices of the collocation.
 
     Returns (points (d,), C (d+1, d): derivative of basis r at point j, D (d+1,): basis r at 1,
     B (d+1,): quadrature weights), the basis over (0, tau_1, ..., tau_d).
     """
-    points = (np.polynomial.legendre.leggauss(degree)[0] + 1.0) / 2.0
+    points = _gauss_points(degree)
     nodes = np.concatenate([[0.0], points])
     C = np.zeros((degree + 1, degree))
     D = np.zeros(degree + 1)
@@ -129,7 +136,7 @@ class ElementInputs:
                         len(self.values) - 1))
         t0, t1 = self.boundaries[k], self.boundaries[k + 1]
         x = (t - t0) / (t1 - t0)
-        points = (np.polynomial.legendre.leggauss(self.values.shape[1])[0] + 1.0) / 2.0
+        points = _gauss_points(self.values.shape[1])
         weights = np.array([math.prod((x - points[s]) / (points[r] - points[s])
                                       for s in range(len(points)) if s != r)
                             for r in range(len(points))])
