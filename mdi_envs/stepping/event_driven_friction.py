@@ -35,7 +35,7 @@ frictionless slip acceleration; the first consistent candidate is taken. After a
 event the stuck set that ran out of margin is excluded (at least one of its contacts slides).
 A contact that starts to stick gets its slip removed exactly (a velocity change of at most
 ``slip_tolerance``, the smallest in the kinetic metric). A starting slide follows d_i until its
-slip speed exceeds twice the tolerance; from then on, gamma_i / |gamma_i|.
+slip speed exceeds ``arm_speed``; from then on, gamma_i / |gamma_i|.
 
 Events are reported as ``Event``s of kind ``stick`` or ``slip`` (element: the contact) and
 ``input_switch``; the modes at the start are ``stick``/``slip`` events at t_start.
@@ -152,6 +152,9 @@ class EventDrivenFrictionIntegrator:
         method: ``solve_ivp`` method of the smooth phases.
         rtol, atol: ODE tolerances (relative; absolute in the units of q and u).
         slip_tolerance: [m/s] a slip speed at or below this is zero (a slide stops there).
+        arm_speed: [m/s] a starting slide keeps its onset direction until its slip speed
+            exceeds this (at least twice ``slip_tolerance``): below it the slip direction
+            turns at a rate ~ 1/|gamma|, which would make the explicit ODE solver crawl.
         max_events: bound on the number of events (status ``max_events`` beyond it).
 
     Raises:
@@ -160,7 +163,8 @@ class EventDrivenFrictionIntegrator:
 
     def __init__(self, model: type[ModelDefinition], parameters: Any = None, *,
                  method: str = "DOP853", rtol: float = 1e-11, atol: float = 1e-12,
-                 slip_tolerance: float = 1e-10, max_events: int = 10_000) -> None:
+                 slip_tolerance: float = 1e-10, arm_speed: float = 1e-6,
+                 max_events: int = 10_000) -> None:
         if not model.HAS_LOAD_TRANSFER or model.CONTACT_DIMENSION != 3:
             raise ValueError(f"{model.__name__}: the friction integrator needs always-closed "
                              "spatial contacts with load transfer (HAS_LOAD_TRANSFER)")
@@ -171,6 +175,7 @@ class EventDrivenFrictionIntegrator:
         self.parameters = model.Parameters() if parameters is None else parameters  # type: ignore[attr-defined]
         self.method, self.rtol, self.atol = method, rtol, atol
         self.slip_tolerance = slip_tolerance
+        self.arm_speed = max(arm_speed, 2.0 * slip_tolerance)
         self.max_events = int(max_events)
         self._p = self.parameters.values()
         self._n, self._m, self._c = model.NUM_DOFS, model.NUM_INPUTS, model.NUM_CONTACTS
@@ -548,7 +553,7 @@ class _FrictionRun:
         events, labels = [], []
         for i in sliding:  # an armed slide stops at the tolerance; a starting one arms at 2x
             stop = i in armed
-            events.append(slip_event(i, ig.slip_tolerance * (1.0 if stop else 2.0),
+            events.append(slip_event(i, ig.slip_tolerance if stop else ig.arm_speed,
                                      -1 if stop else 1))
             labels.append(("stop" if stop else "arm", i))
         if stuck:
