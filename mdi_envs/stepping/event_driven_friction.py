@@ -551,7 +551,7 @@ class _FrictionRun:
 
         margin.terminal, margin.direction = True, -1  # type: ignore[attr-defined]
         events, labels = [], []
-        for i in sliding:  # an armed slide stops at the tolerance; a starting one arms at 2x
+        for i in sliding:  # an armed slide stops at the tolerance; a starting one arms
             stop = i in armed
             events.append(slip_event(i, ig.slip_tolerance if stop else ig.arm_speed,
                                      -1 if stop else 1))
