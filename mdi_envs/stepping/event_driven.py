@@ -271,6 +271,21 @@ class Trajectory:
         return [event for event in self.events if event.kind == kind]
 
 
+def assemble_trajectory(events: list[Event], segments: list[Segment], t_end: float,
+                        status: str, num_rhs_evals: int, sample_times: ArrayLike | None
+                        ) -> Trajectory:
+    """The ``Trajectory`` of a run: its events and smooth segments, sampled at ``sample_times``.
+
+    Default sample times: the start and every step of the ODE solver.
+    """
+    start = events[0].t
+    times = (np.unique(np.concatenate([[start]] + [s.solution.ts for s in segments]))
+             if sample_times is None
+             else np.atleast_1d(np.asarray(sample_times, dtype=np.float64)))
+    q, u = _sample(events[0], tuple(segments), t_end, times)
+    return Trajectory(times, q, u, tuple(events), t_end, status, num_rhs_evals, tuple(segments))
+
+
 def _sample(start: Event, segments: tuple[Segment, ...], t_end: float, times: ArrayLike
             ) -> tuple[FloatArray, FloatArray]:
     """(q, u-) at ``times`` from the dense output (see ``Trajectory.evaluate``)."""
@@ -450,14 +465,8 @@ class EventDrivenIntegrator:
                 break
             if cut < t_final:
                 run.switch(cut)
-        default_times = np.unique(np.concatenate(
-            [[t_start]] + [s.solution.ts for s in run.segments]))
-        times = (default_times if sample_times is None
-                 else np.atleast_1d(np.asarray(sample_times, dtype=np.float64)))
-        events, segments = tuple(run.events), tuple(run.segments)
-        q_s, u_s = _sample(events[0], segments, run.t, times)
-        return Trajectory(times, q_s, u_s, events, run.t, run.status, run.num_rhs_evals,
-                          segments)
+        return assemble_trajectory(run.events, run.segments, run.t, run.status,
+                                   run.num_rhs_evals, sample_times)
 
     def _solve_mixed(self, Minv: NDArray[Any], W_u: NDArray[Any], W_e: NDArray[Any],
                      b_u: NDArray[Any], b_e: NDArray[Any]) -> tuple[FloatArray, FloatArray]:

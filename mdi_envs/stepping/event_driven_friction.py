@@ -66,7 +66,7 @@ from mdi_envs.stepping.event_driven import (
     PiecewiseConstant,
     Segment,
     Trajectory,
-    _sample,
+    assemble_trajectory,
 )
 
 EVENT_STICK = "stick"
@@ -135,12 +135,6 @@ class _DualOps:
     def sin(x: Any) -> Any:
         return _Dual(math.sin(x.v), math.cos(x.v) * x.d) if isinstance(x, _Dual) else math.sin(x)
 
-    @staticmethod
-    def sqrt(x: Any) -> Any:
-        if isinstance(x, _Dual):
-            root_v = math.sqrt(x.v)
-            return _Dual(root_v, 0.5 * x.d / root_v)
-        return math.sqrt(x)
 
 
 class EventDrivenFrictionIntegrator:
@@ -184,6 +178,7 @@ class EventDrivenFrictionIntegrator:
         self.n0 = np.array(n0, dtype=np.float64)  # (c,) [N]
         self.k = np.array(k, dtype=np.float64).reshape(self._c, 2 * self._c)
         self.force_tolerance = 1e-9 * float(np.abs(self.n0).sum())  # [N]
+        self._tangent = np.delete(np.arange(3 * self._c), np.s_[::3])  # rows without normals
 
     # ---- equations ---------------------------------------------------------------------
 
@@ -193,8 +188,7 @@ class EventDrivenFrictionIntegrator:
         rows = self.model.contact_directions(dual_q, self._p, _DualOps)
         value = np.array([[x.v if isinstance(x, _Dual) else x for x in row] for row in rows])
         rate = np.array([[x.d if isinstance(x, _Dual) else 0.0 for x in row] for row in rows])
-        tangent = np.delete(np.arange(3 * self._c), np.s_[::3])
-        return value[tangent], rate[tangent] @ u
+        return value[self._tangent], rate[self._tangent] @ u
 
     def _mass_and_force(self, q: FloatArray, u: FloatArray, tau: FloatArray
                         ) -> tuple[FloatArray, FloatArray]:
@@ -277,8 +271,9 @@ class EventDrivenFrictionIntegrator:
         return (W @ accelerations + rate).reshape(self._c, 2)
 
     def slips(self, q: FloatArray, u: FloatArray) -> FloatArray:
-        """Slip velocities gamma = W u, (c, 2) [m/s]."""
-        return (self.tangent_rows(q, u)[0] @ u).reshape(self._c, 2)
+        """Slip velocities gamma = W u, (c, 2) [m/s] (the rows in floats: no rate needed)."""
+        rows = np.array(self.model.contact_directions(q, self._p, math), dtype=np.float64)
+        return (rows[self._tangent] @ u).reshape(self._c, 2)
 
     # ---- the acceleration-level law at an event ---------------------------------------
 
@@ -422,14 +417,8 @@ class EventDrivenFrictionIntegrator:
                 break
             if cut < t_final:
                 run.switch(cut)
-        segments = tuple(run.segments)
-        default_times = np.unique(np.concatenate([[t_start]] + [s.solution.ts for s in segments]))
-        times = (default_times if sample_times is None
-                 else np.atleast_1d(np.asarray(sample_times, dtype=np.float64)))
-        events = tuple(run.events)
-        q_s, u_s = _sample(events[0], segments, run.t, times)
-        return Trajectory(times, q_s, u_s, events, run.t, run.status, run.num_rhs_evals,
-                          segments)
+        return assemble_trajectory(run.events, run.segments, run.t, run.status,
+                                   run.num_rhs_evals, sample_times)
 
 
 class _FrictionRun:
