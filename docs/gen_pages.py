@@ -34,7 +34,7 @@ from baselines.tables import (
     robustness_table,
 )
 from optimal import available_references, load_reference
-from optimal.convergence import study_limit, study_table
+from optimal.convergence import continuous_cost, study_table
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "docs")]  # benchmarks/ is not installed
@@ -378,7 +378,7 @@ def references_page() -> None:
                   "(`optimal/continuous/NAME.json`; [method](../guide/polish.md)). Cost: t_f "
                   "[s] or the effort integral.", "",
                   table([{"reference": c["name"],
-                          "continuous-time cost": c.get("cost", c.get("final_time")),
+                          "continuous-time cost": continuous_cost(c),
                           "h-discrete optimum": c.get("discrete_cost"),
                           "intervals N": c.get("discrete_num_intervals"),
                           "relative difference": c.get("relative_difference"),
@@ -409,12 +409,7 @@ def references_page() -> None:
 
 
 def refinement_section(study: dict[str, Any]) -> list[str]:
-    """The discrete optimum per N against the continuous one or the extrapolated limit.
-
-    ``optimal.convergence``: a polished continuous optimum where the study has one, else the
-    Richardson extrapolation of its three finest levels.
-    """
-    limit = study_limit(study)
+    """The h-discrete optimum per N against the continuous one (``optimal.convergence``)."""
     def shown(value: float) -> float | None:
         return value if math.isfinite(value) else None
 
@@ -422,44 +417,17 @@ def refinement_section(study: dict[str, Any]) -> list[str]:
              "cost after the mode search": row["cost"], "search rounds": row["max_rounds"],
              "change from the previous N": shown(row["change"]),
              "distance": shown(row["distance"]),
-             "distance / limit": shown(row["relative_distance"]),
+             "distance / optimum": shown(row["relative_distance"]),
              "observed order": shown(row["order"]), "wall time [min]": row["wall_time"] / 60}
             for row in study_table(study)]
     name = study["name"]
-    command = (f"`python -m optimal.convergence {name} --levels N,...` writes "
-               f"`optimal/continuous/{name}_refinement.json`: per N the discrete problem ")
-    if "continuous_cost" in study:
-        return [f"## Refinement toward the continuous optimum: {name}", "",
-                command + f"solved from the continuous optimum ({limit:.7g} s), its brake phases "
-                "projected on the grid, then mode-searched for at most the given rounds "
-                "([method](../guide/polish.md#refinement-toward-the-continuous-optimum)). The "
-                "distance is to the continuous optimum.", "", table(rows, floatfmt=".6g"), ""]
-    continuous_path = ROOT / "optimal" / "continuous" / f"{name}.json"
-    continuous = load(continuous_path)["cost"] if continuous_path.exists() else None
-    if continuous is not None:
-        for row, level in zip(rows, study_table(study), strict=True):
-            row["above the continuous optimum"] = level["cost"] / continuous - 1.0
-    fit = study["extrapolation"]
-    monotone = math.isfinite(fit["value"])
-    before = (f"the three levels before give {fit['previous']:.7g} (uncertainty "
-              f"{fit['uncertainty']:.2g}, their difference)" if math.isfinite(fit["previous"])
-              else "the three levels before admit no such fit, so there is no uncertainty "
-              "estimate")
-    estimate = (f"The limit is **extrapolated, not polished**: cost(N) = c + a h^p through "
-                f"N = {', '.join(map(str, fit['levels']))} gives c = {fit['value']:.7g}, "
-                f"p = {fit['order']:.3f}; {before}. The distance is to c." if monotone else
-                f"The three finest levels (N = {', '.join(map(str, fit['levels']))}) do not "
-                "change monotonically: no extrapolated limit, no distance.")
-    against = (f" The last column compares each level with the continuous-time optimum of "
-               f"the reference's mode sequence ({continuous:.7g}, `optimal/continuous/"
-               f"{name}.json`), whose switching times differ from the fixed pattern's."
-               if continuous is not None else "")
-    return [f"## Refinement with the pattern fixed: {name}", "",
-            command + "solved with the stick-slip phases of the shipped reference's finest "
-            "refinement level projected on the grid and fixed "
-            "([method](../guide/polish.md#robot-extrapolated-limits)). " + estimate + against,
-            "",
-            table(rows, floatfmt=".7g"), ""]
+    return [f"## Refinement toward the continuous optimum: {name}", "",
+            f"`python -m optimal.convergence {name} --levels N,...` writes "
+            f"`optimal/continuous/{name}_refinement.json`: per N the discrete problem solved "
+            f"from the continuous optimum ({study['continuous_cost']:.7g}), its mode sequence "
+            "projected on the grid, then mode-searched for at most the given rounds "
+            "([method](../guide/polish.md#refinement-toward-the-continuous-optimum)). The "
+            "distance is to the continuous optimum.", "", table(rows, floatfmt=".7g"), ""]
 
 
 def search_page() -> None:

@@ -1,22 +1,20 @@
-"""Mesh refinement toward the continuous-time optimum, and the shipped continuous optima.
+"""Mesh refinement toward the continuous-time optimum, and the manipulator's continuous optimum.
 
-``polish_reference(name)`` polishes a shipped reference's mode sequence in continuous time
-(``optimal.polish``), from its own times and from variants of its end (the last brake phase
-as an instant lock at t_f, or engaged up to t_f), and keeps the best; ``optimal/continuous/
-NAME.json`` holds it. ``solve_level`` solves the h-discrete problem on N intervals on one
-branch: with a polished optimum, from it (its mode sequence on the grid, ``pattern_on_grid``,
-so a lock at t_f is the last interval engaged; its trajectory sampled there); without one (the
-robot, which the event-driven integrator cannot follow), from the shipped reference's finest
-refinement level (its stick-slip phases in time on the grid, ``phases_on_grid``; the shipped
-trajectory interpolated). The pattern is fixed, then mode-searched for at most a round limit.
-The limit of a study without a polished optimum is extrapolated from its three finest levels
-(``richardson``). Levels are independent, so a study is resumable:
+``polish_reference(name)`` polishes a shipped reference's brake and torque schedule in
+continuous time (``optimal.polish``), from its own times and from variants of its end (the last
+brake phase as an instant lock at t_f, or engaged up to t_f), and keeps the best;
+``optimal/continuous/NAME.json`` holds it (the robots' continuous optima are
+``optimal.phase_collocation``'s, in the same directory). ``solve_level`` solves the h-discrete
+problem on N intervals on the continuous optimum's branch: its mode sequence on the grid
+(``pattern_on_grid`` for a schedule, so a lock at t_f is the last interval engaged;
+``phases_on_grid`` for stick-slip phases, the last interval the stop at rest), fixed, then
+mode-searched for at most a round limit. Levels are independent, so a study is resumable:
 
     python -m optimal.convergence manipulator_time --levels 30,60,120,240,480
 
 appends each level to ``optimal/continuous/NAME_refinement.json`` when it is done (levels in
 the file are skipped) and redraws ``NAME_refinement.png``: N, the cost, the distance to the
-continuous-time optimum (or the extrapolated limit) and the observed order log2(d_N / d_2N).
+continuous-time optimum and the observed order log2(d_N / d_2N).
 """
 
 from __future__ import annotations
@@ -26,6 +24,8 @@ import dataclasses
 import json
 import math
 import time
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -60,6 +60,9 @@ from optimal.transcription import (
 
 CONTINUOUS_DIR = Path(__file__).parent / "continuous"
 """Where the continuous-time optima and the refinement studies are stored."""
+
+Start = Callable[[int], tuple[OptimalControlProblem, ModePattern, Transcription]]
+"""N -> (problem, mode pattern, initial guess) on N intervals: where a level starts."""
 
 
 def end_variants(schedule: SwitchingSchedule) -> dict[str, SwitchingSchedule]:
@@ -103,18 +106,18 @@ def polish_reference(name: str, directory: Path = CONTINUOUS_DIR) -> dict[str, A
     return record
 
 
-def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: int,
-                max_rounds: int = 8, warm: tuple[OptimalControlProblem, ModeSolve] | None = None,
+def solve_level(start: Start, num_intervals: int, max_rounds: int = 8,
+                warm: tuple[OptimalControlProblem, ModeSolve] | None = None,
                 max_iterations: int = FIXED_PATTERN_MAX_ITERATIONS
                 ) -> tuple[dict[str, Any], OptimalControlProblem, ModeSolve]:
-    """The h-discrete optimum on N intervals on one branch of ``name``.
+    """The h-discrete optimum on N intervals on one branch.
 
-    The start: the continuous-time ``schedule`` (``schedule_start``), or for None the shipped
-    reference's finest refinement level (``reference_start``). Its pattern is solved with the
-    modes fixed, then mode-searched (``improve_modes``, switches +-1, +-2 intervals per move)
-    for at most ``max_rounds`` rounds: the h-discrete optimum on that branch. (Freed by the
-    continuation instead, as ``optimal.refinement.refine`` does, a coarse grid moves to
-    another branch.)
+    ``start(N)`` gives the problem, the mode pattern on the grid and the initial guess
+    (``schedule_start`` from a polished switching schedule, ``phase_start`` from a continuous
+    optimum's stick-slip phases). The pattern is solved with the modes fixed, then
+    mode-searched (``improve_modes``, switches +-1, +-2 intervals per move) for at most
+    ``max_rounds`` rounds: the h-discrete optimum on that branch. (Freed by the continuation
+    instead, as ``optimal.refinement.refine`` does, a coarse grid moves to another branch.)
 
     Args:
         warm: (problem, solve) of a coarser level whose N divides this one: its trajectory
@@ -130,8 +133,7 @@ def solve_level(name: str, schedule: SwitchingSchedule | None, num_intervals: in
         wall time [s]; then the problem and the best solve.
     """
     clock = time.perf_counter()
-    problem, pattern, guess = (reference_start(name, num_intervals) if schedule is None
-                               else schedule_start(name, schedule, num_intervals))
+    problem, pattern, guess = start(num_intervals)
     start = guess.initial_point()
     if warm is not None:
         interpolated_guess(guess, *warm)
@@ -171,25 +173,28 @@ def schedule_start(name: str, schedule: SwitchingSchedule, num_intervals: int
     return problem, pattern, guess
 
 
-def reference_start(name: str, num_intervals: int
-                    ) -> tuple[OptimalControlProblem, ModePattern, Transcription]:
-    """(problem, pattern, guess) on N intervals from the shipped reference ``name``.
+def phase_start(name: str, phases: list[dict[str, Any]], final_time: float,
+                num_intervals: int) -> tuple[OptimalControlProblem, ModePattern, Transcription]:
+    """(problem, pattern, guess) on N intervals from a continuous optimum's stick-slip phases.
 
-    The pattern: the phases of the reference's finest refinement level (its ``refinement``
-    metadata) on the grid of that level's t_f (``phases_on_grid``, a last interval of rest
-    kept one interval long). The guess: the shipped
-    trajectory interpolated in t / t_f, its inputs, friction impulses (scaled by the step
-    ratio) and slip speeds taken from the interval holding each new interval's midpoint, t_f
-    the finest level's.
+    Args:
+        phases: the mode sequence in time, as ``optimal.phase_collocation`` records it: per
+            phase "sliding" (c,) flags, "start" and "end" [s].
+        final_time: t_f [s] of the continuous optimum (the problem's for a time task).
+
+    The pattern: ``phases_on_grid`` (a contact slides in an interval whose midpoint a sliding
+    phase of it covers; the last interval is the stop at rest). The guess: the shipped
+    reference interpolated in t / t_f, its inputs, friction impulses (scaled by the step
+    ratio) and slip speeds taken from the interval holding each new interval's midpoint.
     """
-    reference = load_reference(name)
-    finest = max(reference.metadata["refinement"]["levels"],
-                 key=lambda level: level["num_intervals"])
     problem = make_problem(name, num_intervals)
     if problem.cost == "time":
-        problem = dataclasses.replace(problem, final_time=finest["final_time"])
-    pattern = phases_on_grid(finest["phases"], finest["final_time"], num_intervals,
-                             finest["num_intervals"])
+        problem = dataclasses.replace(problem, final_time=final_time)
+    contacts = len(phases[0]["sliding"])
+    sliding = {f"contact {j}": [[phase["start"], phase["end"]] for phase in phases
+                                if phase["sliding"][j]] for j in range(contacts)}
+    pattern = phases_on_grid(sliding, final_time, num_intervals)
+    reference = load_reference(name)
     shipped = reference.tau.shape[0]
     fraction, fine = reference.time / reference.final_time, np.linspace(0.0, 1.0,
                                                                           num_intervals + 1)
@@ -199,27 +204,25 @@ def reference_start(name: str, num_intervals: int
     guess = Transcription(problem, modes=pattern)
     guess.set_guess(*(np.column_stack([np.interp(fine, fraction, c) for c in values.T])
                       for values in (reference.q, reference.u)),
-                    reference.tau[holder], finest["final_time"], impulses)
+                    reference.tau[holder], final_time, impulses)
     return problem, pattern, guess
 
 
 def phases_on_grid(phases: dict[str, list[list[float]]], final_time: float,
-                   num_intervals: int, source_intervals: int | None = None) -> ModePattern:
+                   num_intervals: int) -> ModePattern:
     """The pattern of ``phases`` (``ModePattern.phases``, on [0, ``final_time``]) on N intervals.
 
     An interval is engaged (a brake) or sliding (a contact) when a phase covers its midpoint.
-    With ``source_intervals`` (the N the phases were read on), a phase ending where the source
-    grid's last interval starts ends where the new grid's does: that single interval of rest
-    is the terminal condition (the step into t_f ends at rest), not a phase of its length.
+    A phase reaching t_f ends where the last interval starts: that interval is the stop at
+    rest (the terminal condition), in which every contact sticks.
     """
     step = final_time / num_intervals
     middle = (np.arange(num_intervals) + 0.5) * step
-    last_start = final_time - final_time / source_intervals if source_intervals else math.nan
     rows: dict[str, list[np.ndarray]] = {"brake": [], "contact": []}
     for label in sorted(phases, key=lambda key: (key.split()[0], int(key.split()[1]))):
         covered = np.zeros(num_intervals, dtype=bool)
         for start, end in phases[label]:
-            if math.isclose(end, last_start, rel_tol=1e-9):
+            if math.isclose(end, final_time, rel_tol=1e-9):
                 end = final_time - step
             covered |= (middle >= start) & (middle <= end)
         rows[label.split()[0]].append(covered)
@@ -264,50 +267,36 @@ def richardson(num_intervals: list[int], costs: list[float]) -> dict[str, float]
             "coefficient": (costs[2] - value) * num_intervals[2] ** order}
 
 
-def extrapolated_limit(study: dict[str, Any]) -> dict[str, Any]:
-    """``richardson`` on the three finest levels, with the spread as its uncertainty.
+def continuous_cost(record: dict[str, Any]) -> float:
+    """A continuous optimum's cost.
 
-    Returns:
-        The finest fit's "value", "order", "coefficient" and "levels"; "previous": the value
-        of the fit to the three levels before the finest (NaN with fewer than four levels);
-        "uncertainty": |value - previous|. A fit is NaN where its three N are not in a
-        constant ratio or ``richardson`` finds none.
+    t_f of a polished schedule; else the extrapolated limit of the collocation levels
+    (``optimal.phase_collocation``), else its finest level's cost.
     """
-    levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
-    if len(levels) < 3:
-        raise ValueError(f"{study['name']}: extrapolation needs three levels, "
-                         f"got {len(levels)}")
-
-    def fit(chosen: list[dict[str, Any]]) -> dict[str, float]:
-        sizes = [level["num_intervals"] for level in chosen]
-        if sizes[2] * sizes[0] != sizes[1] ** 2:  # not N, r N, r^2 N: no fit
-            return {"value": math.nan, "order": math.nan, "coefficient": math.nan}
-        return richardson(sizes, [level["cost"] for level in chosen])
-
-    finest = fit(levels[-3:])
-    previous = fit(levels[-4:-1])["value"] if len(levels) >= 4 else math.nan
-    return {**finest, "levels": [level["num_intervals"] for level in levels[-3:]],
-            "previous": previous, "uncertainty": abs(finest["value"] - previous)}
+    if "schedule" in record:
+        return float(record["final_time"])
+    limit = record.get("extrapolation", {}).get("value", math.nan)
+    return float(limit) if math.isfinite(limit) else float(record["cost"])
 
 
-def study_limit(study: dict[str, Any]) -> float:
-    """The study's target: the polished continuous optimum, else the extrapolated limit."""
-    if "continuous_cost" in study:
-        return float(study["continuous_cost"])
-    return float(study["extrapolation"]["value"])
+def study_start(name: str, record: dict[str, Any]) -> Start:
+    """Where ``name``'s levels start: a polished schedule, or a collocation's phases."""
+    if "schedule" in record:
+        return partial(schedule_start, name, _schedule(record["schedule"]))
+    return partial(phase_start, name, record["phases"], record["final_time"])
 
 
 def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
     """The refinement table: one row per level, coarsest first.
 
     Rows: N, the projected pattern's cost, the cost after the mode search and its round limit,
-    its change from the previous level, the distance d_N = cost - ``study_limit`` (NaN
-    without a limit), d_N / limit, the observed order, wall time [s].
+    its change from the previous level, the distance d_N = cost - the study's
+    "continuous_cost", d_N / continuous_cost, the observed order, wall time [s].
 
     The order of a row is log(d_N / d_N') / log(N' / N) with N' the next level (NaN for the
     last row or where the two distances differ in sign or one is zero).
     """
-    optimum = study_limit(study)
+    optimum = study["continuous_cost"]
     levels = sorted(study["levels"].values(), key=lambda level: level["num_intervals"])
     rows = []
     for i, level in enumerate(levels):
@@ -328,11 +317,9 @@ def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
 
 
 def plot_study(study: dict[str, Any], path: Path) -> None:
-    """Log-log plot of |cost(N) - the study's limit| against N, with the fitted order.
+    """Log-log plot of |cost(N) - the continuous optimum| against N, with a first-order line.
 
-    The reference line has slope -1 toward a polished optimum, -p toward an extrapolated limit
-    (``extrapolated_limit``); filled markers: costs above the limit, open: below. Without a
-    limit (NaN), the changes between consecutive levels.
+    Filled markers: costs above the continuous optimum, open: below.
     """
     import matplotlib
 
@@ -340,33 +327,21 @@ def plot_study(study: dict[str, Any], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     rows = study_table(study)
-    limit = study_limit(study)
+    limit = study["continuous_cost"]
     n = np.array([row["num_intervals"] for row in rows], dtype=float)
     distance = np.array([row["distance"] for row in rows])
     projected = np.array([row["start_cost"] for row in rows]) - limit
-    extrapolated = "continuous_cost" not in study
-    order = study["extrapolation"]["order"] if extrapolated else 1.0
-    target = "extrapolated limit" if extrapolated else "continuous optimum"
-    curves = [(projected, "s:", "0.5", "pattern projected, fixed"),
-              (distance, "o-", "C0", "after the mode search")]
-    if not math.isfinite(limit):  # no limit: the changes between consecutive levels
-        distance = np.array([row["change"] for row in rows])
-        curves, target = [(distance, "o-", "C0", "cost(N) - cost(previous N)")], "no limit"
     figure, axes = plt.subplots(figsize=(5, 3.6))
-    for values, style, color, label in curves:
+    for values, style, color, label in [(projected, "s:", "0.5", "pattern projected, fixed"),
+                                        (distance, "o-", "C0", "after the mode search")]:
         axes.loglog(n, np.abs(values), style, color=color, label=label, markerfacecolor="none")
         above = values > 0
         axes.loglog(n[above], values[above], style[0], color=color)
-    if math.isfinite(order):
-        axes.loglog(n, abs(distance[-1]) * (n[-1] / n) ** order, "k--", lw=0.8,
-                    label=f"order {order:.2f}")
+    axes.loglog(n, abs(distance[-1]) * n[-1] / n, "k--", lw=0.8, label="order 1")
+    axes.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     axes.set_xlabel("N (intervals)")
-    axes.set_ylabel(f"|cost(N) - {target}|" if math.isfinite(limit) else
-                    "|cost(N) - cost(previous N)|")
-    axes.set_title(f"{study['name']}: {target} {limit:.6f}" if math.isfinite(limit) else
-                   f"{study['name']}: no extrapolated limit\n(the three finest levels do not "
-                   "converge monotonically)",
-                   fontsize=9)
+    axes.set_ylabel("|cost(N) - continuous optimum|")
+    axes.set_title(f"{study['name']}: continuous optimum {limit:.6f}", fontsize=9)
     axes.legend(fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
@@ -378,38 +353,35 @@ def run_study(name: str, levels: list[int], directory: Path = CONTINUOUS_DIR,
               ) -> dict[str, Any]:
     """Solve the missing ``levels`` of ``name``'s study one by one, saving after each.
 
-    Levels run coarsest first; a converged level warm-starts the next one solved in the same
-    call when its N divides the next (``solve_level``'s ``warm``).
-
-    With a polished optimum ``NAME.json`` in ``directory`` the levels start from it and it is
-    the study's target; without one they start from the shipped reference
-    (``reference_start``) and the target is ``extrapolated_limit``, stored as "extrapolation"
-    once there are three levels.
+    The levels start from the continuous optimum ``NAME.json`` in ``directory``
+    (``study_start``), its cost (``continuous_cost``) the study's target. They run coarsest
+    first; a converged level warm-starts the next one solved in the same call when its N
+    divides the next (``solve_level``'s ``warm``).
     """
     polished = directory / f"{name}.json"
-    record = json.loads(polished.read_text()) if polished.exists() else None
-    schedule = _schedule(record["schedule"]) if record else None
+    if not polished.exists():
+        raise FileNotFoundError(f"{name}: no continuous optimum {polished}; compute it first "
+                                "(optimal.convergence --polish, or optimal.phase_collocation)")
+    record = json.loads(polished.read_text())
+    start = study_start(name, record)
     path = directory / f"{name}_refinement.json"
     study = json.loads(path.read_text()) if path.exists() else {"name": name, "levels": {}}
-    if record:
-        study["continuous_cost"] = record["final_time"]
+    study["continuous_cost"] = continuous_cost(record)
     warm = None
     for n in sorted(levels):
         if str(n) in study["levels"]:
             continue
-        level, *solved = solve_level(name, schedule, n, max_rounds,
+        level, *solved = solve_level(start, n, max_rounds,
                                      warm if warm and n % warm[0].num_intervals == 0 else None,
                                      max_iterations)
         warm = tuple(solved) if level["converged"] else None
         study["levels"][str(n)] = level
-        if record is None and len(study["levels"]) >= 3:
-            study["extrapolation"] = extrapolated_limit(study)
         path.write_text(json.dumps(study, indent=1) + "\n")
         print(f"N = {n}: cost {level['cost']:.6f} (start {level['start_cost']:.6f}), t_f "
               f"{level['final_time']:.6f} s, converged {level['converged']}, kept pattern "
               f"{level['kept_pattern']}, {len(level['moves'])} moves, "
               f"{level['wall_time']:.0f} s", flush=True)
-    if "continuous_cost" in study or "extrapolation" in study:
+    if study["levels"]:
         plot_study(study, directory / f"{name}_refinement.png")
     return study
 
@@ -442,13 +414,10 @@ def main(argv: list[str] | None = None) -> None:
         run_study(args.name, levels, max_rounds=args.rounds, max_iterations=args.iterations)
     path = CONTINUOUS_DIR / f"{args.name}_refinement.json"
     study = json.loads(path.read_text()) if path.exists() else {}
-    if "continuous_cost" in study or "extrapolation" in study:  # the table, as markdown
-        if "extrapolation" in study:
-            print("extrapolated limit {value:.7f} (order {order:.3f}, from N = {levels}; "
-                  "the three levels before: {previous:.7f}; uncertainty {uncertainty:.1e})"
-                  .format(**study["extrapolation"]))
+    if study.get("levels"):  # the table, as markdown
+        print(f"continuous optimum {study['continuous_cost']:.7f}")
         print("| N | cost, pattern projected | cost after the mode search (rounds) | change | "
-              "distance | distance / limit | observed order |\n|---|---|---|---|---|---|---|")
+              "distance | distance / optimum | observed order |\n|---|---|---|---|---|---|---|")
         for row in study_table(study):
             print("| {num_intervals} | {start_cost:.6f} | {cost:.6f} ({max_rounds}) | "
                   "{change:.3e} | {distance:.3e} | {relative_distance:.3%} | {order:.2f} |"

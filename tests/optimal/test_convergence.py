@@ -2,34 +2,31 @@
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
 import pytest
 
 from optimal.convergence import (
+    CONTINUOUS_DIR,
     end_variants,
-    extrapolated_limit,
     phases_on_grid,
     richardson,
+    schedule_start,
+    study_start,
     study_table,
 )
 from optimal.polish import SwitchingSchedule
-from optimal.references import load_reference
 
 
 def _levels(cost: Callable[[int], float], sizes: tuple[int, ...]) -> dict[str, dict[str, float]]:
     """A synthetic study's levels: cost(N) after the search and as projected."""
     return {str(n): {"num_intervals": n, "cost": cost(n), "start_cost": cost(n),
                      "wall_time": 0.0} for n in sizes}
-
-
-def _flat(phases: dict[str, list[Any]]) -> list[float]:
-    """The phases' labels in order and their times, one list (for ``pytest.approx``)."""
-    return [float(t) for label in sorted(phases) for phase in phases[label] for t in phase] + [
-        len(phases[label]) for label in sorted(phases)]
 
 
 def test_end_variants_replace_the_last_brake_phases() -> None:
@@ -57,28 +54,24 @@ def test_level_of_the_double_integrator_is_its_exact_time() -> None:
     from optimal.convergence import solve_level
 
     # The midpoint step is exact for a held force: with the switch on the grid, T = 2 s.
-    level, _, _ = solve_level("double_integrator",
-                              SwitchingSchedule(((1.0,),), (1.0,), (), 2.0), 10)
+    schedule = SwitchingSchedule(((1.0,),), (1.0,), (), 2.0)
+    level, _, _ = solve_level(partial(schedule_start, "double_integrator", schedule), 10)
     assert level["converged"]
     assert level["cost"] == pytest.approx(2.0, abs=1e-6)
 
 
 def test_richardson_recovers_limit_and_order_of_a_synthetic_series() -> None:
-    levels = _levels(lambda n: 3.5 + 0.8 / n ** 1.3, (25, 50, 100, 200, 400))
-    limit = extrapolated_limit({"name": "synthetic", "levels": levels})
-    assert limit["value"] == pytest.approx(3.5, abs=1e-12)
-    assert limit["order"] == pytest.approx(1.3, abs=1e-9)
-    assert limit["coefficient"] == pytest.approx(0.8, rel=1e-9)
-    assert limit["levels"] == [100, 200, 400]
-    assert limit["uncertainty"] == pytest.approx(0.0, abs=1e-12)
-    # A second-order term makes the two fits differ; the finer one is closer to the limit.
-    levels = _levels(lambda n: 3.5 + 0.8 / n + 5.0 / n ** 2, (25, 50, 100, 200, 400))
-    limit = extrapolated_limit({"name": "synthetic", "levels": levels})
-    assert abs(limit["value"] - 3.5) < abs(limit["previous"] - 3.5)
-    assert limit["uncertainty"] > abs(limit["value"] - 3.5)
-    row_orders = [row["order"] for row in study_table({"levels": levels,
-                                                       "extrapolation": limit})]
-    assert row_orders[-2] == pytest.approx(limit["order"])
+    fit = richardson([100, 200, 400], [3.5 + 0.8 / n ** 1.3 for n in (100, 200, 400)])
+    assert fit["value"] == pytest.approx(3.5, abs=1e-12)
+    assert fit["order"] == pytest.approx(1.3, abs=1e-9)
+    assert fit["coefficient"] == pytest.approx(0.8, rel=1e-9)
+    # A second-order term: the fit through finer levels is closer to the limit.
+    def cost(n: int) -> float:
+        return 3.5 + 0.8 / n + 5.0 / n ** 2
+
+    coarse = richardson([25, 50, 100], [cost(n) for n in (25, 50, 100)])["value"]
+    fine = richardson([100, 200, 400], [cost(n) for n in (100, 200, 400)])["value"]
+    assert abs(fine - 3.5) < abs(coarse - 3.5)
 
 
 def test_richardson_reports_a_series_that_is_not_monotone() -> None:
@@ -87,37 +80,35 @@ def test_richardson_reports_a_series_that_is_not_monotone() -> None:
     assert all(math.isnan(v) for v in richardson([10, 20, 40], [2.0, 2.1, 2.3]).values())
     with pytest.raises(ValueError, match="r\\^2 N"):
         richardson([10, 20, 50], [2.0, 1.9, 1.85])
-    gapped = extrapolated_limit({"name": "gapped",
-                                 "levels": _levels(lambda n: 1.0 + 1.0 / n, (25, 200, 400))})
-    assert math.isnan(gapped["value"]) and math.isnan(gapped["uncertainty"])
 
 
-def test_phases_on_grid_repeats_a_pattern_but_keeps_the_terminal_rest_one_interval() -> None:
-    level = max(load_reference("diff_drive_time").metadata["refinement"]["levels"],
-                key=lambda lv: lv["num_intervals"])
-    n, final_time = level["num_intervals"], level["final_time"]
-    pattern = phases_on_grid(level["phases"], final_time, n, n)
+def _continuous(name: str) -> dict[str, Any]:
+    return json.loads((CONTINUOUS_DIR / f"{name}.json").read_text())
+
+
+def test_phases_on_grid_puts_switches_at_midpoints_and_the_stop_in_the_last_interval() -> None:
+    record = _continuous("diff_drive_effort")
+    wheels_slide = record["phases"][1]
+    assert wheels_slide["sliding"] == [True, True, True]
+    n, final_time = 100, record["final_time"]
+    middle = (np.arange(n) + 0.5) * final_time / n
+    sliding = {f"contact {j}": [[phase["start"], phase["end"]] for phase in record["phases"]
+                                if phase["sliding"][j]] for j in range(3)}
+    pattern = phases_on_grid(sliding, final_time, n)
     assert pattern.engaged is None and pattern.sliding.shape == (3, n)
-    phases = pattern.phases(np.linspace(0.0, final_time, n + 1))
-    assert _flat(phases) == pytest.approx(_flat(level["phases"]), abs=1e-12)
-    # Every contact of this level sticks in the last interval only (the rest at t_f): on a
-    # 4x finer grid, still the last interval only; elsewhere each interval repeated.
-    assert not pattern.sliding[:, -1].any() and pattern.sliding[:, -2].all()
-    finer = phases_on_grid(level["phases"], final_time, 4 * n, n).sliding
-    repeated = pattern.refined(4).sliding
-    np.testing.assert_array_equal(finer[:, :-4], repeated[:, :-4])
-    assert finer[:, -4:-1].all() and not finer[:, -1].any()
+    expected = (middle >= wheels_slide["start"]) & (middle <= wheels_slide["end"])
+    np.testing.assert_array_equal(pattern.sliding[0], expected)
+    np.testing.assert_array_equal(pattern.sliding[1], expected)
+    # the caster slides throughout, but every contact sticks in the last interval (the stop)
+    assert pattern.sliding[2, :-1].all() and not pattern.sliding[:, -1].any()
 
 
-def test_robot_level_with_the_pattern_fixed_is_the_shipped_optimum_of_its_grid() -> None:
+def test_robot_level_from_the_continuous_phases_keeps_them_and_lies_above_the_optimum() -> None:
     pytest.importorskip("casadi")
-    from optimal.convergence import solve_level
+    from optimal.convergence import continuous_cost, solve_level
 
-    # The finest level's stick-slip phases projected on N = 25 are those the shipped N = 25
-    # level (freed and mode-searched) found; solved with them fixed, the same optimum.
-    shipped = load_reference("diff_drive_effort").metadata["refinement"]["levels"][0]
-    assert shipped["num_intervals"] == 25
-    level, _, best = solve_level("diff_drive_effort", None, 25, max_rounds=0)
-    assert level["converged"]
-    assert _flat(level["phases"]) == pytest.approx(_flat(shipped["phases"]), abs=1e-9)
-    assert level["cost"] == pytest.approx(shipped["cost"], rel=1e-8)
+    record = _continuous("diff_drive_effort")
+    level, _, _ = solve_level(study_start("diff_drive_effort", record), 25, max_rounds=0)
+    assert level["converged"] and level["kept_pattern"]
+    optimum = continuous_cost(record)
+    assert optimum < level["cost"] < 1.01 * optimum

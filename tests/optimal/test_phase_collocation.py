@@ -13,11 +13,11 @@ import pytest
 from optimal.phase_collocation import (
     ElementInputs,
     reference_phases,
-    replay_result,
+    solve_level,
     solve_phases,
 )
+from optimal.problems import make_problem
 from optimal.references import load_reference
-from optimal.replay import goal_errors
 
 
 def test_reference_phases_read_the_effort_references_mode_sequence() -> None:
@@ -42,23 +42,37 @@ def test_element_inputs_interpolate_their_collocation_values() -> None:
 @pytest.mark.slow
 def test_effort_optimum_replays_with_its_modes_and_reaches_the_goal() -> None:
     reference = load_reference("diff_drive_effort")
+    coarse_record, coarse = solve_level(reference, 10)
+    fine_record, fine = solve_level(reference, 20, coarser=coarse)
+    assert fine_record["start"] == 10
     errors = []
-    for elements in (5, 10):
-        result = solve_phases(reference, reference_phases(reference), elements=elements)
-        assert result.converged
+    for record, result in ((coarse_record, coarse), (fine_record, fine)):
+        assert record["converged"]
         assert result.final_time == pytest.approx(4.05, abs=1e-9)
-        q, u, trajectory = replay_result(result, reference)
-        assert trajectory.status == "completed"
+        assert record["replay"]["status"] == "completed" and record["replay"]["reaches_goal"]
         switches = np.cumsum([phase.duration for phase in result.phases])[:2]
-        events = [(e.t, e.kind, e.element) for e in trajectory.events
-                  if e.kind in ("stick", "slip") and e.t > 0.0]
+        events = [(t, kind, i) for t, kind, i in record["replay"]["events"] if t > 0.0]
         assert [(kind, i) for _, kind, i in events] == [("slip", 0), ("slip", 1),
                                                         ("stick", 0), ("stick", 1)]
         assert events[0][0] == pytest.approx(switches[0], abs=1e-6)  # a switch of the inputs
         assert events[2][0] == pytest.approx(switches[1], abs=5e-3)  # the slides stop there
-        measured, ok = goal_errors(reference.name, q, u)
-        assert ok
-        errors.append(max(measured.values()))
+        errors.append(max(record["replay"]["goal_errors"].values()))
         # the continuous optimum of this sequence lies below the h-discrete one, within 1 %
         assert 0.99 * reference.cost < result.cost < reference.cost
     assert errors[1] < errors[0] / 2.0
+    assert fine.cost < coarse.cost  # more elements, a larger control space
+
+
+@pytest.mark.slow
+def test_a_solution_warm_starts_its_own_problem() -> None:
+    reference = load_reference("diff_drive_effort")
+    first = solve_phases(reference, reference_phases(reference), elements=10)
+    assert first.converged
+    again = solve_phases(reference, list(first.phases), elements=10, guess=first.samples)
+    assert again.converged
+    assert again.cost == pytest.approx(first.cost, rel=1e-6)  # IPOPT stops at 1e-6
+    # the samples hold the solution: its inputs at the collocation points, its final state
+    assert first.samples.tau == pytest.approx(first.inputs.values.reshape(-1, 2), abs=1e-12)
+    problem = make_problem("diff_drive_effort")
+    for i, value in problem.goal_q.items():
+        assert first.samples.state[-1, i] == pytest.approx(value, abs=1e-8)
