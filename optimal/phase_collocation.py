@@ -431,6 +431,15 @@ def _phase_record(result: CollocationResult) -> list[dict[str, Any]]:
             for phase, a, b in zip(result.phases, starts[:-1], starts[1:], strict=True)]
 
 
+def _solve_from(reference: Reference, elements: int, degree: int,
+                coarser: CollocationResult | None) -> CollocationResult:
+    """``solve_phases`` from the ``coarser`` solution (phases, samples), else the reference."""
+    if coarser is None:
+        return solve_phases(reference, reference_phases(reference), elements, degree)
+    return solve_phases(reference, list(coarser.phases), elements, degree,
+                        guess=coarser.samples)
+
+
 def solve_level(reference: Reference, elements: int, degree: int = 3,
                 coarser: CollocationResult | None = None
                 ) -> tuple[dict[str, Any], CollocationResult]:
@@ -446,11 +455,7 @@ def solve_level(reference: Reference, elements: int, degree: int = 3,
         maneuver's tolerances, its stick and slip events); then the result.
     """
     clock = time.perf_counter()
-    if coarser is None:
-        result = solve_phases(reference, reference_phases(reference), elements, degree)
-    else:
-        result = solve_phases(reference, list(coarser.phases), elements, degree,
-                              guess=coarser.samples)
+    result = _solve_from(reference, elements, degree, coarser)
     wall_time = time.perf_counter() - clock
     q, u, trajectory = replay_result(result, reference)
     errors, ok = goal_errors(reference.name, q, u)
@@ -485,9 +490,10 @@ def polish_reference(name: str, elements: list[int], degree: int = 3,
     for count in counts:
         if count in levels and all(k in levels for k in counts if k > count):
             continue
-        level, coarser = solve_level(reference, count, degree, coarser)
-        if count in levels:  # solved again as the warm start of a finer level
+        if count in levels:  # solved again, without its replay: the start of a finer level
+            coarser = _solve_from(reference, count, degree, coarser)
             continue
+        level, coarser = solve_level(reference, count, degree, coarser)
         levels[count] = level
         print(f"K = {count}: cost {level['cost']:.7f}, converged {level['converged']}, "
               f"replay {level['replay']['status']}, goal errors "
@@ -501,8 +507,8 @@ def _record(reference: Reference, levels: dict[int, dict[str, Any]], degree: int
             ) -> dict[str, Any]:
     """The continuous optimum's record: the finest level, every level, the extrapolation.
 
-    "relative_difference" compares the extrapolated limit (the finest level's cost without
-    one) with the h-discrete reference's cost.
+    "relative_difference" compares ``continuous_cost`` (the extrapolated limit, else the
+    finest level's cost) with the h-discrete reference's cost.
     """
     ordered = [levels[k] for k in sorted(levels)]
     finest = ordered[-1]
@@ -515,17 +521,14 @@ def _record(reference: Reference, levels: dict[int, dict[str, Any]], degree: int
                                  "DOP853, event-driven", "rtol": 1e-11, "atol": 1e-12},
         "levels": ordered, "discrete_cost": reference.cost,
         "discrete_num_intervals": reference.metadata["num_intervals"]}
-    limit = finest["cost"]
     if len(ordered) >= 3:
         last = ordered[-3:]
         try:
             record["extrapolation"] = richardson([lv["elements"] for lv in last],
                                                  [lv["cost"] for lv in last])
-            if math.isfinite(record["extrapolation"]["value"]):
-                limit = record["extrapolation"]["value"]
         except ValueError:  # the three finest levels are not in a constant ratio
             pass
-    record["relative_difference"] = limit / reference.cost - 1.0
+    record["relative_difference"] = continuous_cost(record) / reference.cost - 1.0
     return record
 
 
