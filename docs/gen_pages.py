@@ -34,7 +34,7 @@ from baselines.tables import (
     robustness_table,
 )
 from optimal import available_references, load_reference
-from optimal.convergence import continuous_cost, study_table
+from optimal.convergence import continuous_cost, is_chain, study_table
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "docs")]  # benchmarks/ is not installed
@@ -413,21 +413,30 @@ def refinement_section(study: dict[str, Any]) -> list[str]:
     def shown(value: float) -> float | None:
         return value if math.isfinite(value) else None
 
-    rows = [{"N": row["num_intervals"], "cost, pattern projected": row["start_cost"],
-             "cost after the mode search": row["cost"], "search rounds": row["max_rounds"],
+    rows = [{"N": row["num_intervals"], "cost, pattern fixed": row["start_cost"],
+             "cost after the search": row["cost"], "search rounds": row["max_rounds"],
              "change from the previous N": shown(row["change"]),
              "distance": shown(row["distance"]),
              "distance / optimum": shown(row["relative_distance"]),
              "observed order": shown(row["order"]), "wall time [min]": row["wall_time"] / 60}
             for row in study_table(study)]
     name = study["name"]
+    if is_chain(study):
+        command, method = "--chain --levels N,... --rounds R", (
+            "the shipped reference re-solved on its grid, each finer level refined from the one "
+            "before (its pattern repeated, its trajectory interpolated) and solved with that "
+            "pattern fixed, then freed by the continuation and mode-searched for at most the "
+            "given rounds")
+    else:
+        command, method = "--levels N,...", (
+            "per N the discrete problem solved from the continuous optimum's mode sequence "
+            "projected on the grid, fixed, then mode-searched for at most the given rounds")
     return [f"## Refinement toward the continuous optimum: {name}", "",
-            f"`python -m optimal.convergence {name} --levels N,...` writes "
-            f"`optimal/continuous/{name}_refinement.json`: per N the discrete problem solved "
-            f"from the continuous optimum ({study['continuous_cost']:.7g}), its mode sequence "
-            "projected on the grid, then mode-searched for at most the given rounds "
+            f"`python -m optimal.convergence {name} {command}` writes "
+            f"`optimal/continuous/{name}_refinement.json`: {method} "
             "([method](../guide/polish.md#refinement-toward-the-continuous-optimum)). The "
-            "distance is to the continuous optimum.", "", table(rows, floatfmt=".7g"), ""]
+            f"distance is to the continuous optimum ({study['continuous_cost']:.7g}).", "",
+            table(rows, floatfmt=".7g"), ""]
 
 
 def search_page() -> None:

@@ -14,7 +14,9 @@ mode-searched for at most a round limit. Levels are independent, so a study is r
 
 appends each level to ``optimal/continuous/NAME_refinement.json`` when it is done (levels in
 the file are skipped) and redraws ``NAME_refinement.png``: N, the cost, the distance to the
-continuous-time optimum and the observed order log2(d_N / d_2N).
+continuous-time optimum and the observed order log2(d_N / d_2N). ``--chain`` makes the levels
+the refinement chain from the shipped reference instead (``chain_levels``: each level refined
+from the one before and freed by the continuation), solved in order and replacing the study's.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ import dataclasses
 import json
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -50,7 +52,7 @@ from optimal.polish import (
 )
 from optimal.problems import make_problem, model_of
 from optimal.references import load_reference
-from optimal.refinement import interpolated_guess
+from optimal.refinement import interpolated_guess, refine_level
 from optimal.transcription import (
     GUESS_IMPULSES,
     OptimalControlProblem,
@@ -143,14 +145,72 @@ def solve_level(start: Start, num_intervals: int, max_rounds: int = 8,
         fixed = solve_with_modes(problem, pattern, initial=start, max_iterations=max_iterations,
                                  transcription=guess)
     local = improve_modes(problem, fixed, max_rounds=max_rounds)
-    best, moves = local.best, [step.move for step in local.steps]
-    phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
-    record = {"num_intervals": num_intervals, "cost": best.cost, "final_time": best.final_time,
-              "converged": best.success, "start_cost": fixed.cost,
-              "kept_pattern": fixed.found_modes.key() == pattern.key(), "phases": phases,
-              "moves": moves, "max_rounds": max_rounds,
-              "wall_time": time.perf_counter() - clock}
+    best = local.best
+    record = _level_record(fixed, best, [step.move for step in local.steps], max_rounds, clock)
     return record, problem, best
+
+
+def reference_solve(name: str) -> tuple[OptimalControlProblem, ModeSolve]:
+    """The shipped reference ``name`` solved on its own grid with its own mode pattern fixed.
+
+    The pattern: a brake engaged where the reference's brake bound is infinite, a contact
+    sliding where its slip speed is positive; the initial guess is the reference itself, so
+    the solve reproduces its cost.
+    """
+    reference = load_reference(name)
+    arrays = reference.arrays
+    problem = dataclasses.replace(make_problem(name, reference.tau.shape[0]),
+                                  final_time=reference.final_time)
+    pattern = ModePattern(
+        engaged=np.isinf(arrays["brake_bound"]).T.copy() if "brake_bound" in arrays else None,
+        sliding=(arrays["slip_speed"] > 0.0).T.copy() if "slip_speed" in arrays else None)
+    guess = Transcription(problem, modes=pattern)
+    guess.set_guess(reference.q, reference.u, reference.tau, reference.final_time,
+                    {key: arrays[key] for key in GUESS_IMPULSES if key in arrays})
+    return problem, solve_with_modes(problem, pattern, initial=guess.initial_point(),
+                                     transcription=guess)
+
+
+def chain_levels(name: str, levels: list[int], max_rounds: int = 0
+                 ) -> Iterator[dict[str, Any]]:
+    """The levels of the refinement chain from the shipped reference, coarsest first.
+
+    The first level is the reference re-solved (``reference_solve``; its N must divide the
+    first level's); each level after it is the one before carried to its N and freed by the
+    continuation (``optimal.refinement.refine_level``), so its switches may move by fractions
+    of an interval, then mode-searched for at most ``max_rounds`` rounds. Yields one record
+    per level (as ``solve_level``'s) as soon as it is solved.
+
+    Raises:
+        ValueError: a level's N is not a multiple of the one before (or of the reference's).
+    """
+    clock = time.perf_counter()
+    problem, solve = reference_solve(name)
+    for n in sorted(levels):
+        if n % problem.num_intervals:
+            raise ValueError(f"{name}: level N = {n} is not a multiple of "
+                             f"N = {problem.num_intervals} before it in the chain")
+        if n == problem.num_intervals:
+            fixed, moves = solve, []
+        else:
+            fine = dataclasses.replace(make_problem(name, n), final_time=solve.final_time)
+            fixed, solve, moves = refine_level(problem, solve, fine, max_rounds)
+            problem = fine
+        yield {**_level_record(fixed, solve, moves, max_rounds, clock),
+               "start": "reference chain"}
+        clock = time.perf_counter()
+
+
+def _level_record(fixed: ModeSolve, best: ModeSolve, moves: list[str], max_rounds: int,
+                  clock: float) -> dict[str, Any]:
+    """A level's plain-JSON record (``solve_level``'s Returns); ``clock`` its start time."""
+    num_intervals = best.modes.num_intervals
+    phases = best.found_modes.phases(np.linspace(0.0, best.final_time, num_intervals + 1))
+    return {"num_intervals": num_intervals, "cost": best.cost, "final_time": best.final_time,
+            "converged": best.success, "start_cost": fixed.cost,
+            "kept_pattern": fixed.found_modes.key() == fixed.modes.key(), "phases": phases,
+            "moves": moves, "max_rounds": max_rounds,
+            "wall_time": time.perf_counter() - clock}
 
 
 def schedule_start(name: str, schedule: SwitchingSchedule, num_intervals: int
@@ -316,6 +376,11 @@ def study_table(study: dict[str, Any]) -> list[dict[str, float]]:
     return rows
 
 
+def is_chain(study: dict[str, Any]) -> bool:
+    """Whether the study's levels are the refinement chain from the reference (``--chain``)."""
+    return any(level.get("start") == "reference chain" for level in study["levels"].values())
+
+
 def plot_study(study: dict[str, Any], path: Path) -> None:
     """Log-log plot of |cost(N) - the continuous optimum| against N, with a first-order line.
 
@@ -332,8 +397,9 @@ def plot_study(study: dict[str, Any], path: Path) -> None:
     distance = np.array([row["distance"] for row in rows])
     projected = np.array([row["start_cost"] for row in rows]) - limit
     figure, axes = plt.subplots(figsize=(5, 3.6))
-    for values, style, color, label in [(projected, "s:", "0.5", "pattern projected, fixed"),
-                                        (distance, "o-", "C0", "after the mode search")]:
+    fixed_label = "pattern refined, fixed" if is_chain(study) else "pattern projected, fixed"
+    for values, style, color, label in [(projected, "s:", "0.5", fixed_label),
+                                        (distance, "o-", "C0", "after the search")]:
         axes.loglog(n, np.abs(values), style, color=color, label=label, markerfacecolor="none")
         above = values > 0
         axes.loglog(n[above], values[above], style[0], color=color)
@@ -349,41 +415,53 @@ def plot_study(study: dict[str, Any], path: Path) -> None:
 
 
 def run_study(name: str, levels: list[int], directory: Path = CONTINUOUS_DIR,
-              max_rounds: int = 8, max_iterations: int = FIXED_PATTERN_MAX_ITERATIONS
-              ) -> dict[str, Any]:
-    """Solve the missing ``levels`` of ``name``'s study one by one, saving after each.
+              max_rounds: int = 8, max_iterations: int = FIXED_PATTERN_MAX_ITERATIONS,
+              chain: bool = False) -> dict[str, Any]:
+    """Solve ``levels`` of ``name``'s study one by one, saving after each.
 
-    The levels start from the continuous optimum ``NAME.json`` in ``directory``
-    (``study_start``), its cost (``continuous_cost``) the study's target. They run coarsest
-    first; a converged level warm-starts the next one solved in the same call when its N
-    divides the next (``solve_level``'s ``warm``).
+    The study's target is the continuous optimum ``NAME.json`` in ``directory``
+    (``continuous_cost``). By default the levels start from it (``study_start``) and only the
+    missing ones are solved, coarsest first; a converged level warm-starts the next one solved
+    in the same call when its N divides the next (``solve_level``'s ``warm``). With ``chain``
+    the levels are the refinement chain from the shipped reference (``chain_levels``), all
+    solved in order, and replace the study's levels.
     """
     polished = directory / f"{name}.json"
     if not polished.exists():
         raise FileNotFoundError(f"{name}: no continuous optimum {polished}; compute it first "
                                 "(optimal.convergence --polish, or optimal.phase_collocation)")
     record = json.loads(polished.read_text())
-    start = study_start(name, record)
     path = directory / f"{name}_refinement.json"
     study = json.loads(path.read_text()) if path.exists() else {"name": name, "levels": {}}
     study["continuous_cost"] = continuous_cost(record)
+    if chain:
+        study["levels"] = {}
+        solved = chain_levels(name, levels, max_rounds)
+    else:
+        solved = _independent_levels(study_start(name, record), sorted(
+            n for n in levels if str(n) not in study["levels"]), max_rounds, max_iterations)
+    for level in solved:
+        study["levels"][str(level["num_intervals"])] = level
+        path.write_text(json.dumps(study, indent=1) + "\n")
+        print(f"N = {level['num_intervals']}: cost {level['cost']:.6f} (start "
+              f"{level['start_cost']:.6f}), t_f {level['final_time']:.6f} s, converged "
+              f"{level['converged']}, kept pattern {level['kept_pattern']}, "
+              f"{len(level['moves'])} moves, {level['wall_time']:.0f} s", flush=True)
+    if study["levels"]:
+        plot_study(study, directory / f"{name}_refinement.png")
+    return study
+
+
+def _independent_levels(start: Start, levels: list[int], max_rounds: int, max_iterations: int
+                        ) -> Iterator[dict[str, Any]]:
+    """``solve_level`` for each of ``levels`` (ascending), the previous converged one warm."""
     warm = None
-    for n in sorted(levels):
-        if str(n) in study["levels"]:
-            continue
+    for n in levels:
         level, *solved = solve_level(start, n, max_rounds,
                                      warm if warm and n % warm[0].num_intervals == 0 else None,
                                      max_iterations)
         warm = tuple(solved) if level["converged"] else None
-        study["levels"][str(n)] = level
-        path.write_text(json.dumps(study, indent=1) + "\n")
-        print(f"N = {n}: cost {level['cost']:.6f} (start {level['start_cost']:.6f}), t_f "
-              f"{level['final_time']:.6f} s, converged {level['converged']}, kept pattern "
-              f"{level['kept_pattern']}, {len(level['moves'])} moves, "
-              f"{level['wall_time']:.0f} s", flush=True)
-    if study["levels"]:
-        plot_study(study, directory / f"{name}_refinement.png")
-    return study
+        yield level
 
 
 def _schedule(data: dict[str, Any]) -> SwitchingSchedule:
@@ -403,6 +481,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--rounds", type=int, default=8, help="mode-search rounds per level")
     parser.add_argument("--iterations", type=int, default=FIXED_PATTERN_MAX_ITERATIONS,
                         help="IPOPT's limit in a level's first fixed-pattern solve")
+    parser.add_argument("--chain", action="store_true",
+                        help="the levels refined from the shipped reference, each from the one "
+                             "before and freed (they replace the study's levels)")
     args = parser.parse_args(argv)
     if args.polish:
         record = polish_reference(args.name)
@@ -411,12 +492,13 @@ def main(argv: list[str] | None = None) -> None:
               f"s ({100 * record['relative_difference']:+.3f} %)", flush=True)
     levels = [int(n) for n in args.levels.split(",") if n]
     if levels:
-        run_study(args.name, levels, max_rounds=args.rounds, max_iterations=args.iterations)
+        run_study(args.name, levels, max_rounds=args.rounds, max_iterations=args.iterations,
+                  chain=args.chain)
     path = CONTINUOUS_DIR / f"{args.name}_refinement.json"
     study = json.loads(path.read_text()) if path.exists() else {}
     if study.get("levels"):  # the table, as markdown
         print(f"continuous optimum {study['continuous_cost']:.7f}")
-        print("| N | cost, pattern projected | cost after the mode search (rounds) | change | "
+        print("| N | cost, pattern fixed | cost after the search (rounds) | change | "
               "distance | distance / optimum | observed order |\n|---|---|---|---|---|---|---|")
         for row in study_table(study):
             print("| {num_intervals} | {start_cost:.6f} | {cost:.6f} ({max_rounds}) | "

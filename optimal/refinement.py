@@ -106,12 +106,8 @@ def refine(problem: OptimalControlProblem, solve: ModeSolve, factors: Sequence[i
         clock = time.perf_counter()
         previous = levels[-1]
         fine = dataclasses.replace(at(base_n * factor), final_time=previous.solve.final_time)
-        pattern = previous.solve.modes.refined(factor // previous.factor)
-        guess = Transcription(fine, modes=pattern)
-        interpolated_guess(guess, previous.problem, previous.solve)
-        fixed = solve_with_modes(fine, pattern, initial=guess.initial_point(), transcription=guess,
-                                 mu_strategy=mu_strategy)
-        best, moves = settle(fine, fixed, max_rounds)
+        _, best, moves = refine_level(previous.problem, previous.solve, fine, max_rounds,
+                                      mu_strategy)
         level = Level(factor, fine, best, _phases(best), time.perf_counter() - clock, moves)
         levels.append(level)
         if progress is not None:
@@ -119,6 +115,27 @@ def refine(problem: OptimalControlProblem, solve: ModeSolve, factors: Sequence[i
                      f"{best.final_time:.5f} s, converged {best.success}, "
                      f"{len(moves)} moves ({level.wall_time:.0f} s)")
     return Refinement(levels)
+
+
+def refine_level(coarse: OptimalControlProblem, solve: ModeSolve, fine: OptimalControlProblem,
+                 max_rounds: int = 8, mu_strategy: str = "adaptive"
+                 ) -> tuple[ModeSolve, ModeSolve, list[str]]:
+    """Carry ``solve`` (a solution of ``coarse``) to ``fine``, whose N is a multiple of coarse's.
+
+    The pattern refined (each interval repeated), solved with the modes fixed from the
+    interpolated trajectory (``interpolated_guess``; IPOPT's barrier update ``mu_strategy``),
+    then freed and mode-searched for at most ``max_rounds`` rounds (``settle``).
+
+    Returns:
+        (fixed, best, moves): the fixed-pattern solve, the best solve and the moves accepted.
+    """
+    pattern = solve.modes.refined(fine.num_intervals // coarse.num_intervals)
+    guess = Transcription(fine, modes=pattern)
+    interpolated_guess(guess, coarse, solve)
+    fixed = solve_with_modes(fine, pattern, initial=guess.initial_point(), transcription=guess,
+                             mu_strategy=mu_strategy)
+    best, moves = settle(fine, fixed, max_rounds)
+    return fixed, best, moves
 
 
 def settle(problem: OptimalControlProblem, fixed: ModeSolve, max_rounds: int = 8

@@ -112,3 +112,30 @@ def test_robot_level_from_the_continuous_phases_keeps_them_and_lies_above_the_op
     assert level["converged"] and level["kept_pattern"]
     optimum = continuous_cost(record)
     assert optimum < level["cost"] < 1.01 * optimum
+
+
+def test_reference_solve_reproduces_the_shipped_reference() -> None:
+    pytest.importorskip("casadi")
+    from optimal.convergence import reference_solve
+    from optimal.references import load_reference
+
+    problem, solve = reference_solve("diff_drive_time")
+    reference = load_reference("diff_drive_time")
+    assert problem.num_intervals == reference.tau.shape[0]
+    assert solve.success and solve.found_modes.key() == solve.modes.key()
+    assert solve.cost == pytest.approx(reference.cost, rel=1e-7)
+
+
+@pytest.mark.slow
+def test_reference_chain_moves_toward_the_continuous_optimum() -> None:
+    pytest.importorskip("casadi")
+    from optimal.convergence import chain_levels, continuous_cost
+
+    optimum = continuous_cost(_continuous("diff_drive_time"))
+    coarse, fine = chain_levels("diff_drive_time", [100, 200])
+    assert coarse["num_intervals"] == 100 and fine["num_intervals"] == 200
+    assert fine["converged"] and fine["start_cost"] >= fine["cost"] - 1e-9
+    # refined and freed, the grid's optimum comes closer to the continuous one
+    assert abs(fine["cost"] - optimum) < 0.75 * abs(coarse["cost"] - optimum)
+    with pytest.raises(ValueError, match="not a multiple"):
+        list(chain_levels("diff_drive_time", [150]))
