@@ -72,3 +72,16 @@ def test_reference_replays_to_the_goal_in_the_gym_env(name: str) -> None:
     # maneuver this moves the wheel angles by up to ~2e-5 rad, the manipulator's by < 1e-6
     atol = 1e-6 if reference.brake_bound is not None else 1e-4
     np.testing.assert_allclose(q, reference.q[steps], atol=atol)
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_reference_is_within_the_shipping_rule_of_its_continuous_optimum(name: str) -> None:
+    import json
+
+    pytest.importorskip("casadi")
+    from optimal.convergence import CONTINUOUS_DIR, continuous_cost
+    from optimal.solve import SHIPPED_LEVEL_CHANGE
+
+    record = json.loads((CONTINUOUS_DIR / f"{name}.json").read_text())
+    optimum = continuous_cost(record)
+    assert abs(load_reference(name).cost / optimum - 1.0) < SHIPPED_LEVEL_CHANGE
