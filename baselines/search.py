@@ -423,14 +423,21 @@ def plot(name: str, url: str = DEFAULT_STORAGE, output: Path = SEARCH_DIR) -> li
 
 
 def summary(name: str, url: str = DEFAULT_STORAGE) -> dict[str, Any]:
-    """Trial counts by state, the best trial's score, evaluation and arguments."""
+    """Trial counts by state, the compute spent and left, the best trial's score and arguments.
+
+    "cpu_hours": the trials' recorded wall times summed (a trial trains on one core);
+    "remaining": finished (complete or pruned) trials still to run up to ``NUM_TRIALS``.
+    """
     import optuna
 
     study = load_study(name, url, create=False)
     counts: dict[str, int] = {}
     for trial in study.trials:
         counts[trial.state.name] = counts.get(trial.state.name, 0) + 1
-    result: dict[str, Any] = {"study": name, "trials": counts}
+    finished = counts.get("COMPLETE", 0) + counts.get("PRUNED", 0)
+    result: dict[str, Any] = {
+        "study": name, "trials": counts, "remaining": max(NUM_TRIALS - finished, 0),
+        "cpu_hours": sum(t.user_attrs.get("wall_time", 0.0) for t in study.trials) / 3600}
     if study.get_trials(states=(optuna.trial.TrialState.COMPLETE,)):
         best = study.best_trial
         last = max(int(key.split("_")[1]) for key in best.user_attrs if

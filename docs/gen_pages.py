@@ -466,7 +466,9 @@ def search_page() -> None:
             result = summary(study.study_name, url)
             lines += [f"## {study.study_name}", "",
                       table([{"trials " + k.lower(): v for k, v in result["trials"].items()}
-                             | {"best trial": result.get("best_trial"),
+                             | {"trials to run": result["remaining"],
+                                "CPU-hours spent": result["cpu_hours"],
+                                "best trial": result.get("best_trial"),
                                 "best score": result.get("best_score")}]), ""]
             if "best_params" in result:
                 lines += ["Best trial's evaluation and settings:", "",

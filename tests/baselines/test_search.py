@@ -89,6 +89,10 @@ def test_study_resumes_records_its_trials_and_writes_the_best_into_yaml(tmp_path
     assert [e["timesteps"] for e in evaluations] == sorted(e["timesteps"] for e in evaluations)
     assert trial.value == evaluations[-1]["score"]
     assert trial.intermediate_values[4] == trial.value
+    summary = search.summary(name, url)
+    assert summary["trials"] == {"COMPLETE": 2} and summary["remaining"] == search.NUM_TRIALS - 2
+    assert summary["cpu_hours"] == pytest.approx(
+        sum(t.user_attrs["wall_time"] for t in study.trials) / 3600)
     best = search.best_arguments(name, url)
     assert best["policy_kwargs"] == {"net_arch": {"pi": [64, 64], "vf": [64, 64]}}
 
