@@ -179,7 +179,8 @@ def chain_levels(name: str, levels: list[int], max_rounds: int = 0
     first level's); each level after it is the one before carried to its N and freed by the
     continuation (``optimal.refinement.refine_level``), so its switches may move by fractions
     of an interval, then mode-searched for at most ``max_rounds`` rounds. Yields one record
-    per level (as ``solve_level``'s) as soon as it is solved.
+    per level (as ``solve_level``'s) as soon as it is solved; a level that does not converge
+    ends the chain.
 
     Raises:
         ValueError: a level's N is not a multiple of the one before (or of the reference's).
@@ -198,6 +199,8 @@ def chain_levels(name: str, levels: list[int], max_rounds: int = 0
             problem = fine
         yield {**_level_record(fixed, solve, moves, max_rounds, clock),
                "start": "reference chain"}
+        if not solve.success:
+            return
         clock = time.perf_counter()
 
 
