@@ -40,10 +40,12 @@ ALGORITHM_CLASSES = {
     "CrossQ": "sb3_contrib:CrossQ",
     "HybridPPO": "baselines.hybrid_ppo:HybridPPO",
     "DAgger": "baselines.distill:DAgger",
+    "DAgger+PPO": "baselines.distill:DAgger",
 }
 """Algorithm name -> "module:class" of its SB3-compatible class (imported on use, see
 ``baselines.train.algorithm_class``; this module imports no SB3). ``DAgger`` (the distilled
-policies of ``baselines.distill``, not trained by ``mdi-envs train``) only loads."""
+policies of ``baselines.distill``) and ``DAgger+PPO`` (those fine-tuned by ``baselines.finetune``)
+are not trained by ``mdi-envs train``; they only load."""
 
 HYPERPARAMS_DIR = Path(__file__).parent / "hyperparams"
 """The shipped rl-zoo3 hyperparameter files (package data)."""

@@ -8,6 +8,8 @@ bridges the two: after each step it resets the copies that ended through
 ``reset(options={"reset_mask": done})``, which also clears their pending next-step reset, so
 the wrapped env never takes an autoreset step. The result equals SB3's ``DummyVecEnv`` over
 ``gym.make`` copies seeded alike, step for step (``tests/baselines/test_vec_env.py``).
+``TimeAwareVecEnv`` appends each copy's elapsed time to its observations, the batched form of
+``baselines.time_input``'s input.
 
 Example::
 
@@ -31,6 +33,7 @@ from stable_baselines3.common.vec_env.base_vec_env import (
     VecEnvIndices,
     VecEnvObs,
     VecEnvStepReturn,
+    VecEnvWrapper,
 )
 
 import mdi_envs  # noqa: F401 - registers the ids
@@ -187,4 +190,44 @@ class MoreauJeanVecEnv(VecEnv):
         return [int(i) for i in indices]
 
 
-__all__ = ["MoreauJeanVecEnv", "make_vec_env"]
+class TimeAwareVecEnv(VecEnvWrapper):  # type: ignore[misc]
+    """A ``VecEnv`` whose (N, d) observations get each copy's ``steps / limit`` appended.
+
+    ``steps`` counts the actions of the copy's episode (0 after its reset), as Gymnasium's
+    ``TimeAwareObservation(normalize_time=True)`` and ``baselines.time_input.with_time`` do; a
+    done copy's ``terminal_observation`` carries its final count.
+
+    Args:
+        venv: the batched env (Box observations, done copies reset within the step).
+        limit: the episode's step limit (``baselines.time_input.max_steps`` of one copy).
+    """
+
+    def __init__(self, venv: VecEnv, limit: int) -> None:
+        space = venv.observation_space
+        low = np.append(space.low, 0.0).astype(np.float32)
+        high = np.append(space.high, 1.0).astype(np.float32)
+        super().__init__(venv, observation_space=spaces.Box(low, high, dtype=np.float32))
+        self.limit = int(limit)
+        self.steps = np.zeros(venv.num_envs, dtype=np.int64)
+
+    def _with_time(self, observations: np.ndarray) -> np.ndarray:
+        return np.column_stack([observations, self.steps / self.limit]).astype(np.float32)
+
+    def reset(self) -> VecEnvObs:
+        """Reset every copy: counts 0."""
+        self.steps[:] = 0
+        return self._with_time(self.venv.reset())
+
+    def step_wait(self) -> VecEnvStepReturn:
+        """Step every copy; a done copy's count restarts at 0 with its next episode."""
+        observations, rewards, dones, infos = self.venv.step_wait()
+        self.steps += 1
+        for i in np.flatnonzero(dones):
+            final = np.asarray(infos[i]["terminal_observation"], dtype=np.float32)
+            elapsed = np.float32(self.steps[i] / self.limit)
+            infos[i]["terminal_observation"] = np.append(final, elapsed)
+        self.steps[dones] = 0
+        return self._with_time(observations), rewards, dones, infos
+
+
+__all__ = ["MoreauJeanVecEnv", "TimeAwareVecEnv", "make_vec_env"]

@@ -1,4 +1,4 @@
-"""The SB3 VecEnv adapter: SB3's contract and equality with DummyVecEnv over gym.make."""
+"""The SB3 VecEnv adapters: SB3's contract and equality with DummyVecEnv over gym.make."""
 
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ import pytest
 from stable_baselines3.common.vec_env import DummyVecEnv, VecMonitor
 
 import mdi_envs  # noqa: F401 - registers the ids
-from baselines.vec_env import MoreauJeanVecEnv, make_vec_env
+from baselines.time_input import time_aware
+from baselines.vec_env import MoreauJeanVecEnv, TimeAwareVecEnv, make_vec_env
 
 MANIPULATOR = "mdi_envs/BlockableManipulator-v0"
 DIFF_DRIVE = "mdi_envs/DiffDriveRobot-v0"
@@ -164,3 +165,30 @@ def test_hybrid_actions_equal_dummy_vec_env_in_both_layouts() -> None:
             assert info["brake_engaged"] == info_ref["brake_engaged"]
         num_dones += int(dones.sum())
     assert num_dones >= NUM_ENVS
+
+
+def test_the_time_aware_adapter_equals_dummy_vec_env_over_time_aware_copies() -> None:
+    env_id, kwargs = CASES[0]
+    ours = TimeAwareVecEnv(make_vec_env(env_id, NUM_ENVS, **kwargs), kwargs["max_episode_steps"])
+    reference = DummyVecEnv([lambda: time_aware(_single(env_id, kwargs))
+                             for _ in range(NUM_ENVS)])  # fmt: skip
+    assert ours.observation_space == reference.observation_space
+    ours.seed(3)
+    reference.seed(3)
+    np.testing.assert_allclose(ours.reset(), reference.reset(), rtol=1e-6, atol=1e-6)
+    rng = np.random.default_rng(1)
+    finals = 0
+    for _ in range(80):  # two episodes of 37 steps per copy, and a third begun
+        actions = _actions(ours, rng)
+        obs, _, dones, infos = ours.step(actions)
+        obs_ref, _, dones_ref, infos_ref = reference.step(actions)
+        np.testing.assert_allclose(obs, obs_ref, rtol=1e-6, atol=1e-6)
+        np.testing.assert_array_equal(dones, dones_ref)
+        for info, info_ref in zip(infos, infos_ref, strict=True):
+            if "terminal_observation" in info_ref:
+                finals += 1
+                assert info["terminal_observation"][-1] == pytest.approx(1.0)
+                np.testing.assert_allclose(info["terminal_observation"],
+                                           info_ref["terminal_observation"], rtol=1e-6,
+                                           atol=1e-6)  # fmt: skip
+    assert finals == 2 * NUM_ENVS
