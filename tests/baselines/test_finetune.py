@@ -16,7 +16,7 @@ import pytest
 pytest.importorskip("stable_baselines3", reason="needs the rl extra")
 import torch  # noqa: E402
 
-from baselines.distill import DAgger, DAggerSettings, distill  # noqa: E402
+from baselines.distill import DAgger, DAggerSettings, distill, validation_rank  # noqa: E402
 from baselines.evaluation import MANIPULATOR_V1, load_policy, play  # noqa: E402
 from baselines.finetune import (  # noqa: E402
     ALGO,
@@ -26,8 +26,8 @@ from baselines.finetune import (  # noqa: E402
     value_parameters_only,
 )
 
-TINY = FinetuneSettings(timesteps=256, value_warmup=256, num_envs=4, n_steps=64, batch_size=64,
-                        n_epochs=2)
+TINY = FinetuneSettings(timesteps=512, value_warmup=256, num_envs=4, n_steps=64, batch_size=64,
+                        n_epochs=2, validation=2, validate_every=256)
 
 
 @pytest.fixture(scope="module")
@@ -61,14 +61,23 @@ def test_a_fine_tuned_policy_is_written_and_plays_as_a_trained_row(distilled: Pa
     config = json.loads(path.with_suffix(".json").read_text())
     assert config["algo"] == ALGO and config["seed"] == 2
     assert config["num_timesteps"] >= TINY.value_warmup + TINY.timesteps
-    assert config["finetuning"]["distilled"] == distilled.stem
+    entry = config["finetuning"]
+    assert entry["distilled"] == distilled.stem and entry["validated_at"] == [0, 256, 512]
+    # the kept policy is the best validated one, the later on a tie
+    ranks = [validation_rank(success, cost) for success, cost
+             in zip(entry["validation_success"], entry["validation_cost"], strict=True)]
+    assert entry["kept_at"] == max(at for at, rank in zip(entry["validated_at"], ranks,
+                                                          strict=True) if rank == min(ranks))
     assert config["algo_kwargs"]["observe_time"] and config["env_kwargs"]["action_mode"] == "hybrid"
     assert (tmp_path / f"{path.stem}_curve.csv").exists() and path.with_suffix(".png").exists()
-    # the policy's log std was reset to the settings' before training; PPO moves it a little
-    start = DAgger.load(distilled.with_suffix(".zip")).policy
     tuned = DAgger.load(path).policy
-    assert np.allclose(tuned.log_std.detach().numpy(), TINY.log_std, atol=0.05)
-    assert not torch.equal(tuned.log_std, start.log_std)
+    if entry["kept_at"] > 0:  # PPO's policy: the log std reset to the settings', moved a little
+        assert np.allclose(tuned.log_std.detach().numpy(), TINY.log_std, atol=0.05)
+    else:  # the distilled policy's actions, the value network warmed up
+        start = DAgger.load(distilled.with_suffix(".zip")).policy.state_dict()
+        for name, weights in tuned.state_dict().items():
+            if "value_net" not in name and name != "log_std":
+                assert torch.equal(weights, start[name]), name
     controller = load_policy(path.with_suffix(".json"))
     assert controller.label == ALGO
     episode = play(MANIPULATOR_V1, controller.make_policy, 0, **controller.env_kwargs)
@@ -80,6 +89,8 @@ def test_bad_requests_are_errors(distilled: Path, tmp_path: Path) -> None:
         FinetuneSettings(learning_rate=0.0)
     with pytest.raises(ValueError, match="gamma"):
         FinetuneSettings(gamma=1.5)
+    with pytest.raises(ValueError, match="validation_scales"):
+        FinetuneSettings(validation_scales=(0.1, 0.01))
     record = json.loads(distilled.read_text())
     (tmp_path / "ppo.json").write_text(json.dumps({**record, "algo": "PPO"}))
     with pytest.raises(ValueError, match="not a distilled"):

@@ -22,7 +22,8 @@ HYPERPARAMETERS = hyperparameter_table()
 
 
 def test_table_covers_both_envs_tasks_and_algorithms() -> None:
-    assert len(HYPERPARAMETERS) == 20 and set(ALGORITHM_CLASSES) == {*ALGORITHMS, "DAgger", "DAgger+PPO"}
+    assert len(HYPERPARAMETERS) == 20
+    assert set(ALGORITHM_CLASSES) == {*ALGORITHMS, "DAgger", "DAgger+PPO"}
     for (env_id, objective, algo), entry in HYPERPARAMETERS.items():
         assert env_id in gym.registry and algo in ALGORITHMS and objective in ("time", "effort")
         assert {"num_envs", "total_timesteps", "seed", "algo_kwargs", "env_kwargs",
