@@ -10,7 +10,8 @@ network with PPO on the task's own reward, from the distilled weights:
   ``start_scale`` (``reset_noise_scale``), the elapsed time appended when the policy observes it
   (``baselines.vec_env.TimeAwareVecEnv``);
 - the policy's log standard deviation is set to ``log_std`` (exploration about the distilled
-  mean action), and its value network, which the imitation never trained, is fitted first for
+  mean action), its optimizer is a fresh Adam (the saved one's moment estimates are the
+  imitation's), and its value network, which the imitation never trained, is fitted first for
   ``value_warmup`` steps with every other weight frozen;
 - then PPO (``learning_rate``, ``clip_range`` and ``target_kl`` small, so that the policy stays
   near the one it starts from) for ``timesteps`` steps;
@@ -185,6 +186,10 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
     model = DAgger.load(distilled.with_suffix(".zip"), env=venv, **settings.ppo_arguments())
     model.set_random_seed(source.seed)
     venv.seed(source.seed)
+    # a fresh Adam: the saved one's moments are the imitation's, whose tiny converged gradients
+    # would scale PPO's first steps up by orders of magnitude
+    model.policy.optimizer = model.policy.optimizer_class(
+        model.policy.parameters(), lr=settings.learning_rate, **model.policy.optimizer_kwargs)
     if hasattr(model.policy, "log_std"):
         with torch.no_grad():
             model.policy.log_std.fill_(settings.log_std)
