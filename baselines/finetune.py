@@ -19,9 +19,9 @@ network with PPO on the task's own reward, from the distilled weights:
   ``validation_scales``, reset seeds apart from the evaluations') before PPO and after every
   ``validate_every`` steps; the policy that succeeds most often, and among those arrives soonest
   (or spends least), is the one kept (the later one on a tie), as DAgger keeps its best round.
-  PPO from a near-deterministic policy can also lose what the imitation learned (one robot
-  seed went from 1.3x to 1.9x the optimal time in 3 x 10^6 steps); the kept policy is then an
-  earlier one, at worst the distilled policy itself.
+  PPO from a near-deterministic policy can lose what the imitation learned (the guide's
+  fine-tuning section measures it on the robot); the policy kept is then an earlier one, at
+  worst the distilled policy itself.
 
 The result is written like every trained baseline (``baselines.train``: ``STEM.zip``,
 ``STEM.json``, ``STEM_curve.csv``, ``STEM.png``) with ``algo`` ``ALGO`` and
@@ -199,7 +199,7 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
     validated_at: list[int] = []
     success: list[float] = []
     costs: list[float | None] = []
-    kept: dict[str, Any] = {}
+    best: dict[str, Any] = {}
 
     def validate(steps: int) -> None:
         episodes = [play(source.env_id, model_policy(model, observe_time), reset_seed,
@@ -209,8 +209,8 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
         success.append(float(np.mean([episode.is_success for episode in episodes])))
         costs.append(validation_cost(episodes, source.objective))
         rank = validation_rank(success[-1], costs[-1])
-        if not kept or rank <= validation_rank(success[kept["index"]], costs[kept["index"]]):
-            kept.update(index=len(success) - 1, state=copy.deepcopy(model.policy.state_dict()))
+        if not best or rank <= validation_rank(success[best["index"]], costs[best["index"]]):
+            best.update(index=len(success) - 1, state=copy.deepcopy(model.policy.state_dict()))
         if log_line is not None:
             log_line(f"{steps} steps: validation success {success[-1]:.2f}, cost {costs[-1]}")
 
@@ -226,7 +226,7 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
         model.learn(chunk, callback=log, reset_num_timesteps=False)
         done += chunk
         validate(done)
-    model.policy.load_state_dict(kept["state"])
+    model.policy.load_state_dict(best["state"])
     wall_time = time.perf_counter() - start
     venv.close()
 
@@ -253,7 +253,7 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
         command=f"mdi-envs finetune {source.env_id} --seeds {source.seed} --timesteps "
                 f"{settings.timesteps} --start-scale {settings.start_scale}")  # fmt: skip
     entry = Finetuning(distilled.stem, source.commit, asdict(settings), validated_at, success,
-                       costs, validated_at[kept["index"]])
+                       costs, validated_at[best["index"]])
     data = {**asdict(record), "finetuning": asdict(entry)}
     (output / f"{stem}.json").write_text(json.dumps(data, indent=2, default=str) + "\n")
     plot_training(log.rows, output / f"{stem}.png",
