@@ -186,8 +186,7 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
     model = DAgger.load(distilled.with_suffix(".zip"), env=venv, **settings.ppo_arguments())
     model.set_random_seed(source.seed)
     venv.seed(source.seed)
-    # a fresh Adam: the saved one's moments are the imitation's, whose tiny converged gradients
-    # would scale PPO's first steps up by orders of magnitude
+    # a fresh Adam: the saved one holds the imitation's moment estimates
     model.policy.optimizer = model.policy.optimizer_class(
         model.policy.parameters(), lr=settings.learning_rate, **model.policy.optimizer_kwargs)
     if hasattr(model.policy, "log_std"):
@@ -251,7 +250,8 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
         evaluation=evaluation, versions=versions(), commit=git_commit(),
         date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         command=f"mdi-envs finetune {source.env_id} --seeds {source.seed} --timesteps "
-                f"{settings.timesteps} --start-scale {settings.start_scale}")  # fmt: skip
+                f"{settings.timesteps} --value-warmup {settings.value_warmup} --start-scale "
+                f"{settings.start_scale} --learning-rate {settings.learning_rate}")  # fmt: skip
     entry = Finetuning(distilled.stem, source.commit, asdict(settings), validated_at, success,
                        costs, validated_at[best["index"]])
     data = {**asdict(record), "finetuning": asdict(entry)}
