@@ -49,7 +49,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import json
 import math
 import os
 import time
@@ -486,6 +485,7 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
         evaluate,
         run_name,
         versions,
+        write_record,
     )
 
     start = time.perf_counter()
@@ -512,8 +512,7 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
                 f"--gradient-steps {settings.gradient_steps} --start-scales "
                 f"{settings.start_scales[0]} {settings.start_scales[1]}"
                 + (" --observe-time" if settings.observe_time else ""))
-    data = {**asdict(training), "distillation": asdict(record)}
-    (output / f"{stem}.json").write_text(json.dumps(data, indent=2, default=str) + "\n")
+    write_record(output / f"{stem}.json", training, distillation=record)
     return output / f"{stem}.zip"
 
 

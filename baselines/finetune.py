@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import json
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -161,13 +160,14 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
     from baselines.plots import plot_training
     from baselines.train import (
         EpisodeLog,
-        RecentEpisodes,
         TrainingRecord,
         evaluate,
         read_training,
+        recent_episodes,
         run_name,
         versions,
         write_logs,
+        write_record,
     )
     from baselines.vec_env import TimeAwareVecEnv, make_vec_env
 
@@ -236,7 +236,6 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
     evaluation = evaluate(model, source.env_id, env_kwargs, eval_episodes, source.seed + 10_000,
                           observe_time)  # fmt: skip
     write_logs(log.rows, output / f"{stem}_episodes.csv", output / f"{stem}_curve.csv")
-    recent = log.rows[-100:]
     budget = settings.value_warmup + settings.timesteps
     record = TrainingRecord(
         env_id=source.env_id, objective=source.objective, algo=ALGO, seed=source.seed,
@@ -244,9 +243,7 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
         algo_kwargs={**settings.ppo_arguments(), "observe_time": observe_time},
         algo_overrides={}, env_kwargs=env_kwargs, policy="MlpPolicy", device="cpu",
         torch_threads=torch.get_num_threads(), wall_time_s=wall_time, num_episodes=len(log.rows),
-        train_last100=RecentEpisodes(
-            float(np.mean([r[1] for r in recent])) if recent else None,
-            float(np.mean([r[3] for r in recent])) if recent else None),
+        train_last100=recent_episodes(log.rows),
         evaluation=evaluation, versions=versions(), commit=git_commit(),
         date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         command=f"mdi-envs finetune {source.env_id} --seeds {source.seed} --timesteps "
@@ -254,8 +251,7 @@ def finetune(distilled: Path, settings: FinetuneSettings = FinetuneSettings(),
                 f"{settings.start_scale} --learning-rate {settings.learning_rate}")  # fmt: skip
     entry = Finetuning(distilled.stem, source.commit, asdict(settings), validated_at, success,
                        costs, validated_at[best["index"]])
-    data = {**asdict(record), "finetuning": asdict(entry)}
-    (output / f"{stem}.json").write_text(json.dumps(data, indent=2, default=str) + "\n")
+    write_record(output / f"{stem}.json", record, finetuning=entry)
     plot_training(log.rows, output / f"{stem}.png",
                   title=f"{stem} (PPO from {distilled.stem}, {settings.num_envs} envs)")
     return output / f"{stem}.zip"

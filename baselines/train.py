@@ -149,6 +149,24 @@ class TrainingRecord:
     normalize_reward: bool = False
 
 
+def recent_episodes(rows: list[tuple[Any, ...]]) -> RecentEpisodes:
+    """``RecentEpisodes`` of the last 100 of ``EpisodeLog.rows`` (``EPISODE_COLUMNS`` order)."""
+    recent = rows[-100:]
+    if not recent:
+        return RecentEpisodes(None, None)
+    return RecentEpisodes(float(np.mean([r[1] for r in recent])),
+                          float(np.mean([r[3] for r in recent])))  # fmt: skip
+
+
+def write_record(path: Path, record: TrainingRecord, **entries: Any) -> None:
+    """Write ``record`` as the JSON ``path``, with dataclass ``entries`` beside its fields.
+
+    E.g. ``write_record(path, record, distillation=Distillation(...))``.
+    """
+    data = {**asdict(record), **{name: asdict(entry) for name, entry in entries.items()}}
+    Path(path).write_text(json.dumps(data, indent=2, default=str) + "\n")
+
+
 def read_training(path: Path) -> TrainingRecord:
     """The ``TrainingRecord`` of a ``STEM.json`` (pydantic's ``ValidationError`` if malformed)."""
     from baselines.records import from_json
@@ -304,23 +322,20 @@ def train(
 
     evaluation = evaluate(model, env_id, env_kwargs, eval_episodes, seed=seed + 10_000)
     write_logs(log.rows, output / f"{stem}_episodes.csv", output / f"{stem}_curve.csv")
-    recent = log.rows[-100:]
     record = TrainingRecord(
         env_id=env_id, objective=objective, algo=algo, seed=seed, num_envs=num_envs,
         total_timesteps=total_timesteps, num_timesteps=int(model.num_timesteps),
         algo_kwargs=algo_kwargs, algo_overrides=algo_overrides or {}, env_kwargs=env_kwargs,
         policy="MlpPolicy", device="cpu", torch_threads=torch.get_num_threads(),
         wall_time_s=wall_time, num_episodes=len(log.rows),
-        train_last100=RecentEpisodes(
-            float(np.mean([r[1] for r in recent])) if recent else None,
-            float(np.mean([r[3] for r in recent])) if recent else None),
+        train_last100=recent_episodes(log.rows),
         evaluation=evaluation, versions=versions(), commit=git_commit(),
         date=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         command=f"mdi-envs train {env_id} {algo} --objective {objective} --seed {seed} "
                 f"--timesteps {total_timesteps} --num-envs {num_envs}"
                 + (" (plus algo_overrides)" if algo_overrides else ""),
         normalize_reward=entry["normalize_reward"])  # fmt: skip
-    (output / f"{stem}.json").write_text(json.dumps(asdict(record), indent=2, default=str) + "\n")
+    write_record(output / f"{stem}.json", record)
     from baselines.plots import plot_training
 
     plot_training(log.rows, output / f"{stem}.png", title=f"{stem} ({algo}, {num_envs} envs)")
@@ -391,6 +406,6 @@ def versions() -> dict[str, str]:
 
 __all__ = [
     "EpisodeLog", "PolicyEvaluation", "RecentEpisodes", "TrainingRecord", "algorithm_class",
-    "check_single_env", "evaluate", "load_trained", "read_training", "run_name", "train",
-    "with_schedules", "write_logs",
+    "check_single_env", "evaluate", "load_trained", "read_training", "recent_episodes",
+    "run_name", "train", "with_schedules", "write_logs", "write_record",
 ]
