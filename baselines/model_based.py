@@ -39,6 +39,9 @@ LQR = "LQR (time-varying)"
 STATE_INDEXED = "state-indexed"
 """Appended to the label of a state-indexed row (``INDEX_WINDOW``)."""
 
+PARKING = "parking"
+"""Appended to the label of a state-indexed row supervised by ``Recovering``."""
+
 INDEX_WINDOW = 10
 """The state-indexed controllers' search window [reference nodes] (``optimal.observations``)."""
 
@@ -137,6 +140,19 @@ def tracking_state_controller(env_id: str, objective: str) -> Controller | None:
                                 index_window=INDEX_WINDOW)
 
 
+def tracking_state_parking_controller(env_id: str, objective: str) -> Controller | None:
+    """The state-indexed tracking MPC, on the robot supervised by ``Recovering``.
+
+    Once its nearest reference node is the last one and the episode goes on (the robot at rest
+    outside the goal box, or still short of it), the parking follower takes over. None without
+    a reference or CasADi.
+    """
+    from optimal.tracking import TrackingMPC
+
+    return reference_controller(f"{TRACKING}, {STATE_INDEXED}, {PARKING}", TrackingMPC, env_id,
+                                objective, supervised=True, index_window=INDEX_WINDOW)
+
+
 def reference_controller(label: str, controller_class: Callable[[Reference], Any], env_id: str,
                          objective: str, needs_casadi: bool = True, supervised: bool = False,
                          **attributes: Any) -> Controller | None:
@@ -170,13 +186,16 @@ def reference_controller(label: str, controller_class: Callable[[Reference], Any
 
 EXPERTS: dict[str, Callable[[str, str], Controller | None]] = {
     "lqr": lqr_controller, "tracking": tracking_controller,
-    "tracking-state": tracking_state_controller, "mpc": mpc_controller,
+    "tracking-state": tracking_state_controller,
+    "tracking-state-parking": tracking_state_parking_controller, "mpc": mpc_controller,
 }  # fmt: skip
 """Feedback expert name -> its ``ControllerFactory`` (``baselines.evaluation``), the experts of
 the distillation and the datasets: the time-varying LQR (microseconds per step), the tracking
-MPC (milliseconds; time- or state-indexed), the shrinking-horizon MPC (0.1-1 s)."""
+MPC (milliseconds; time- or state-indexed, the latter with or without the parking supervisor),
+the shrinking-horizon MPC (0.1-1 s)."""
 
 
-__all__ = ["EXPERTS", "INDEX_WINDOW", "LQR", "MPC", "STATE_INDEXED", "TRACKING", "Recovering",
-           "lqr_controller", "mpc_controller", "reference_controller", "row_env_options",
-           "tracking_controller", "tracking_state_controller"]
+__all__ = ["EXPERTS", "INDEX_WINDOW", "LQR", "MPC", "PARKING", "STATE_INDEXED", "TRACKING",
+           "Recovering", "lqr_controller", "mpc_controller", "reference_controller",
+           "row_env_options", "tracking_controller", "tracking_state_controller",
+           "tracking_state_parking_controller"]
