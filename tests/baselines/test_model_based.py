@@ -6,6 +6,7 @@ import warnings
 
 import gymnasium as gym
 import numpy as np
+import pytest
 
 from baselines.model_based import Recovering, row_env_options
 from mdi_envs.maneuvers import DIFF_DRIVE_MANEUVER
@@ -28,18 +29,34 @@ class _Still:
         return step
 
 
-def test_past_the_reference_outside_the_goal_box_it_parks_the_robot() -> None:
-    """The tracker for the reference's N steps, then the parking follower into the goal box.
+class _StillAtTheLastNode(_Still):
+    """A state-indexed tracker that applies no torque, nearest the reference's last node."""
 
-    The tracker applies no torque, so the robot stays at rest 0.3 m before the goal for N
-    steps; the follower reaches the goal box before the episode's 2 N steps end.
+    def __init__(self, last_node: int) -> None:
+        self.last_node = last_node
+
+    def __call__(self, _observation: np.ndarray) -> np.ndarray:
+        self.last_step = self.last_node
+        return np.zeros(2, np.float32)
+
+
+@pytest.mark.parametrize("state_indexed", [False, True], ids=["time-indexed", "state-indexed"])
+def test_past_the_reference_outside_the_goal_box_it_parks_the_robot(state_indexed: bool) -> None:
+    """The tracker until it has acted for the last node, then the parking follower into the goal.
+
+    The tracker applies no torque, so the robot stays at rest 0.3 m before the goal: a
+    time-indexed tracker for the reference's N steps, a state-indexed one at its last node for
+    one step; the follower reaches the goal box before the episode's 2 N steps end.
     """
     reference = load_reference("diff_drive_time")
     options = {**row_env_options(reference), "reset_noise_scale": 0.0}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = gym.make(reference.metadata["env_id"], **options)
-    policy = Recovering(_Still(), reference, env)
+    last_node = len(reference.tau) - 1
+    tracker = _StillAtTheLastNode(last_node) if state_indexed else _Still()
+    handover = 1 if state_indexed else len(reference.tau)
+    policy = Recovering(tracker, reference, env)
     policy.reset()
     env.reset(seed=0)
     gx, gy, gphi = DIFF_DRIVE_MANEUVER.goal_pose
@@ -47,10 +64,12 @@ def test_past_the_reference_outside_the_goal_box_it_parks_the_robot() -> None:
     obs, steps, done = env.unwrapped.state.obs[0].copy(), 0, False
     while not done:
         action = policy(obs)
-        if steps < len(reference.tau):
+        if steps < handover:
             assert policy.recovery is None and not action.any()
+        else:
+            assert policy.recovery is not None
         obs, _, terminated, truncated, info = env.step(action)
         steps += 1
         done = terminated or truncated
     assert terminated and info["is_success"]
-    assert len(reference.tau) < steps < 2 * len(reference.tau)
+    assert handover < steps < 2 * len(reference.tau)
