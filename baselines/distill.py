@@ -95,6 +95,7 @@ class DAggerSettings:
             whose learner succeeds most often (the later on a tie) is the one returned.
         start_scales: (low, high), the range of the perturbed starts' noise half-width
             ``reset_noise_scale`` [rad, rad/s, m, m/s], drawn log-uniformly.
+        validation_scales: the same range for the validation starts; None: ``start_scales``.
         observe_time: the learner also sees the normalized elapsed time
             (``baselines.time_input``), as a time-indexed expert does.
     """
@@ -108,6 +109,7 @@ class DAggerSettings:
     net_arch: tuple[int, ...] = (256, 256)
     validation: int = 10
     start_scales: tuple[float, float] = (0.01, 0.1)
+    validation_scales: tuple[float, float] | None = None
     observe_time: bool = False
 
     def __post_init__(self) -> None:
@@ -118,10 +120,11 @@ class DAggerSettings:
             raise ValueError(f"rounds must be >= 0, got {self.rounds}")
         if not 0.0 <= self.beta_decay < 1.0:
             raise ValueError(f"beta_decay must be in [0, 1), got {self.beta_decay}")
-        low, high = self.start_scales
-        if not 0.0 < low <= high:
-            raise ValueError(f"start_scales must be (low, high) with 0 < low <= high, "
-                             f"got {self.start_scales}")
+        for name in ("start_scales", "validation_scales"):
+            scales = getattr(self, name)
+            if scales is not None and not 0.0 < scales[0] <= scales[1]:
+                raise ValueError(f"{name} must be (low, high) with 0 < low <= high, "
+                                 f"got {scales}")
         if self.learning_rate <= 0.0 or not self.net_arch or min(self.net_arch) < 1:
             raise ValueError(f"need learning_rate > 0 and a non-empty net_arch of positive "
                              f"widths, got {self.learning_rate} and {self.net_arch}")
@@ -378,7 +381,8 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
     env_kwargs = learner_env_kwargs(env_id, controller)
     model: Any = None  # made after round 0, whose expert data give the observation statistics
     labels = _Labels([], [])
-    validation = perturbed_starts(rng, settings.validation, settings.start_scales)
+    validation = perturbed_starts(rng, settings.validation,
+                                  settings.validation_scales or settings.start_scales)
     sizes, losses, mixture, validated, costs = [], [], [], [], []
     best, best_round = None, 0
     for round_ in range(settings.rounds + 1):
@@ -510,7 +514,10 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
         command=f"mdi-envs distill {env_id} --expert {expert} --seeds {seed} --rounds "
                 f"{settings.rounds} --episodes {settings.episodes} "
                 f"--gradient-steps {settings.gradient_steps} --start-scales "
-                f"{settings.start_scales[0]} {settings.start_scales[1]}"
+                f"{settings.start_scales[0]} {settings.start_scales[1]} --validation "
+                f"{settings.validation}"
+                + (" --validation-scales {} {}".format(*settings.validation_scales)
+                   if settings.validation_scales else "")
                 + (" --observe-time" if settings.observe_time else ""))
     write_record(output / f"{stem}.json", training, distillation=record)
     return output / f"{stem}.zip"
@@ -536,6 +543,13 @@ def add_distill_parser(subparsers: Any) -> argparse.ArgumentParser:
                         metavar=("LOW", "HIGH"),
                         help="range of the perturbed starts' noise half-width, drawn "
                              "log-uniformly (default: %(default)s)")
+    parser.add_argument("--validation", type=int, default=defaults.validation,
+                        help="starts the learner plays alone after each round to choose the "
+                             "round kept (default: %(default)s)")
+    parser.add_argument("--validation-scales", type=float, nargs=2, default=None,
+                        metavar=("LOW", "HIGH"),
+                        help="range of the validation starts' noise half-width (default: "
+                             "--start-scales)")
     parser.add_argument("--observe-time", action="store_true",
                         help="the learner also sees the normalized elapsed time (for a "
                              "time-indexed expert)")
@@ -559,6 +573,9 @@ def run_distill(args: argparse.Namespace) -> int:
         settings = DAggerSettings(rounds=args.rounds, episodes=args.episodes,
                                    gradient_steps=args.gradient_steps,
                                    start_scales=tuple(args.start_scales),
+                                   validation=args.validation,
+                                   validation_scales=(None if args.validation_scales is None
+                                                      else tuple(args.validation_scales)),
                                    observe_time=args.observe_time)
         for seed in args.seeds:
             stem = run_name(args.env_id, OBJECTIVES.get(args.env_id, ("",))[0], ALGO, seed)

@@ -99,6 +99,7 @@ def test_the_distilled_manipulator_loads_and_plays_as_a_trained_row(tmp_path: Pa
     assert config["algo"] == "DAgger" and config["env_kwargs"]["action_mode"] == "hybrid"
     assert config["distillation"]["expert"] == "lqr"
     assert config["distillation"]["expert_calls"] == config["num_timesteps"] > 0
+    assert config["command"].endswith("--validation 1")  # what reruns this seed
     torch.set_num_threads(2)
     controller = load_policy(path.with_suffix(".json"))
     assert controller.label == "DAgger" and controller.training is not None
@@ -195,6 +196,8 @@ def test_bad_requests_are_errors(tmp_path: Path) -> None:
         DAggerSettings(start_scales=(0.1, 0.01))
     with pytest.raises(ValueError, match="start_scales must be"):
         DAggerSettings(start_scales=(0.0, 0.1))
+    with pytest.raises(ValueError, match="validation_scales must be"):
+        DAggerSettings(validation_scales=(0.3, 0.1))
     with pytest.raises(ValueError, match="shape"):
         expert_label(np.zeros(3), hybrid=True)
     parser = argparse.ArgumentParser()
