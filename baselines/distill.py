@@ -22,7 +22,8 @@ Ross et al.'s choice of the best policy on validation, in the tables' order (suc
 ratio).
 
 Perturbed starts draw the start noise half-width ``reset_noise_scale`` log-uniformly in
-``DAggerSettings.start_scales`` [rad, rad/s, m, m/s] and reset seeds from
+``DAggerSettings.start_scales`` [rad, rad/s, m, m/s] (the validation starts in
+``validation_scales`` if given) and reset seeds from
 ``FIRST_TRAINING_SEED`` on, apart from the evaluation's seeds 0, 1, ....
 
 The learner is an SB3 policy: ``PPO``'s ``ActorCriticPolicy`` on the robots' Box actions,
