@@ -1,7 +1,8 @@
 """The headline results (RL vs MPC vs optimal) from the committed comparison JSON.
 
-``python docs/headline.py`` prints the README's results table and writes its plot,
-``docs/assets/headline.png``; ``docs/gen_pages.py`` uses the same table on the results page.
+``python docs/headline.py`` prints the README's results table (the v1 ids) and writes its plot,
+``docs/assets/headline.png``; ``docs/gen_pages.py`` uses the same table, with the v0 ids, on
+the results page.
 The numbers come from ``baselines/comparison/compare_*.json`` (``mdi-envs compare all``).
 """
 
@@ -27,11 +28,29 @@ def comparisons(folder: Path = COMPARISON_DIR) -> list[Study]:
     return sorted(studies, key=lambda study: study.env_id.rsplit("-", 1)[-1])
 
 
-def _scores(study: Study, row: Row) -> tuple[Estimate, Estimate]:
+def current(studies: list[Study]) -> list[Study]:
+    """The studies of the current (v1) ids: the README's table and plot."""
+    return [study for study in studies if study.env_id.endswith("-v1")]
+
+
+ROW_ORDER = ("optimal", "MPC", "LQR", "DAgger", "PPO", "HybridPPO", "SAC")
+"""Rows by kind: the reference, model-based control, the distilled and RL policies, then the
+heuristic floor (any label not listed)."""
+
+
+def ordered(rows: Sequence[Row]) -> list[Row]:
+    """The rows in ``ROW_ORDER`` by the first word of their label (stable within a kind)."""
+    def rank(row: Row) -> int:
+        kind = row.label.split()[0]
+        return ROW_ORDER.index(kind) if kind in ROW_ORDER else len(ROW_ORDER)
+    return sorted(rows, key=rank)
+
+
+def _scores(study: Study, row: Row, condition: str) -> tuple[Estimate, Estimate]:
     """The row's success rate and its ratio to the optimum (time or effort, the objective's)."""
-    aggregate = row.aggregate(study.conditions[0].label)
+    aggregate = row.aggregate(condition)
     if aggregate is None:
-        raise ValueError(f"{study.name}: row {row.label!r} has no aggregate")
+        raise ValueError(f"{study.name}: row {row.label!r} has no aggregate at {condition!r}")
     return aggregate.success_rate, getattr(aggregate, f"{study.objective}_ratio")
 
 
@@ -43,21 +62,31 @@ def _text(row: Row, estimate: Estimate, percent: bool = False) -> str:
 
 
 def headline_frame(studies: list[Study]) -> pd.DataFrame:
-    """One row per env x objective x controller: success and ratio to the optimum, IQM [CI]."""
+    """One row per env x objective x controller; per start noise, success and ratio IQM [CI].
+
+    The columns name the start-perturbation scale of each study condition (0.01 and 0.1 in the
+    committed comparisons); the ratio is time (or effort) over the optimum's on the successes.
+    """
     rows = []
     for study in studies:
-        for row in study.rows:
-            success, ratio = _scores(study, row)
-            rows.append({"env": study.env_id.removeprefix("mdi_envs/"),
-                         "objective": study.objective, "controller": row.label,
-                         "runs": success.n + success.missing,
-                         "success": _text(row, success, percent=True),
-                         "time or effort / optimal": _text(row, ratio)})
+        for row in ordered(study.rows):
+            record = {"env": study.env_id.removeprefix("mdi_envs/"),
+                      "objective": study.objective, "controller": row.label,
+                      "runs": len(row.at(study.conditions[0].label))}
+            scored = [(c.scale, *_scores(study, row, c.label)) for c in study.conditions]
+            for scale, success, _ in scored:
+                record[f"success, noise {scale:g}"] = _text(row, success, percent=True)
+            for scale, _, ratio in scored:
+                record[f"ratio, noise {scale:g}"] = _text(row, ratio)
+            rows.append(record)
     return pd.DataFrame(rows)
 
 
 def headline_plot(studies: list[Study], path: Path = PLOT) -> Path:
-    """Success (bars) and ratio to the optimum (dots) per controller; a panel per study, 3 a row."""
+    """Per study a panel: success (bars) and ratio to the optimum (dots) per controller.
+
+    One bar and one dot per start noise (light: the first condition, dark: the last).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -65,27 +94,37 @@ def headline_plot(studies: list[Study], path: Path = PLOT) -> Path:
 
     columns = min(3, len(studies))
     rows = -(-len(studies) // columns)
-    fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 3.6 * rows), squeeze=False)
     for ax in axes.flat[len(studies):]:
         ax.set_visible(False)
     for ax, study in zip(axes.flat, studies, strict=False):
-        labels = [_short(row.label) for row in study.rows]
-        success, ratio = zip(*(_scores(study, row) for row in study.rows), strict=True)
-        x = range(len(labels))
-        ax.bar(x, [s.iqm or 0.0 for s in success], color="tab:green", alpha=0.8,
-               yerr=_errors(success), capsize=3, label="success (IQM, 95 % CI)")
-        ax.set_ylim(0, 1.05)
-        ax.set_xticks(list(x), labels, fontsize=7, rotation=35, ha="right")
-        ax.set_title(f"{study.env_id.removeprefix('mdi_envs/')}, {study.objective}", fontsize=9)
+        controllers = ordered(study.rows)
         twin = ax.twinx()
-        shown = [i for i, r in enumerate(ratio) if r.iqm is not None]
-        twin.errorbar(shown, [ratio[i].iqm for i in shown],
-                      yerr=_errors([ratio[i] for i in shown]), fmt="o", color="black",
-                      capsize=3, label="time or effort / optimal")
+        top = 2.2
+        width = 0.8 / len(study.conditions)
+        for k, condition in enumerate(study.conditions):
+            shade = 0.45 + 0.45 * k / max(1, len(study.conditions) - 1)
+            offset = (k - (len(study.conditions) - 1) / 2) * width
+            success, ratio = zip(*(_scores(study, row, condition.label) for row in controllers),
+                                 strict=True)
+            x = [i + offset for i in range(len(controllers))]
+            ax.bar(x, [s.iqm or 0.0 for s in success], width=width, color="tab:green",
+                   alpha=shade, yerr=_errors(success), capsize=2,
+                   label=f"success, noise {condition.scale:g}")
+            shown = [i for i, r in enumerate(ratio) if r.iqm is not None]
+            top = max([top] + [1.1 * ratio[i].iqm for i in shown])
+            twin.errorbar([x[i] for i in shown], [ratio[i].iqm for i in shown],
+                          yerr=_errors([ratio[i] for i in shown]), fmt="o", markersize=4,
+                          color=str(0.6 * (1 - k / max(1, len(study.conditions) - 1))),
+                          capsize=2, label=f"ratio, noise {condition.scale:g}")
+        ax.set_ylim(0, 1.05)
+        ax.set_xticks(range(len(controllers)), [_short(r.label) for r in controllers],
+                      fontsize=7, rotation=35, ha="right")
+        ax.set_title(f"{study.env_id.removeprefix('mdi_envs/')}, {study.objective}", fontsize=9)
         twin.axhline(1.0, color="gray", lw=0.8, ls=":")
-        twin.set_ylim(0, max([2.2] + [1.1 * ratio[i].iqm for i in shown]))
+        twin.set_ylim(0, top)
         if ax is axes[0][0]:
-            ax.set_ylabel("success rate")
+            ax.set_ylabel("success rate (IQM, 95 % CI)")
             ax.legend(loc="lower left", fontsize=7)
         if ax is axes[0][columns - 1]:
             twin.set_ylabel("time or effort / optimal")
@@ -101,6 +140,7 @@ SHORT_LABELS = {
     "optimal (open loop)": "optimal, open loop", "LQR (time-varying)": "LQR",
     "MPC (shrinking horizon)": "MPC, shrinking", "MPC (tracking window)": "MPC, tracking",
     "MPC (tracking window), state-indexed": "MPC, tracking by state",
+    "MPC (tracking window), state-indexed, parking": "MPC, by state, parking",
     "rigid-arm bang-bang": "bang-bang floor", "rolling path follower": "rolling floor",
 }
 """Row labels as the plot's tick labels."""
@@ -123,7 +163,7 @@ def _errors(estimates: Sequence[Estimate]) -> list[list[float]]:
 
 def main() -> int:
     """Print the README table and write the plot."""
-    studies = comparisons()
+    studies = current(comparisons())
     print(headline_frame(studies).to_markdown(index=False))
     print(f"wrote {headline_plot(studies).relative_to(ROOT)}", file=sys.stderr)
     return 0
