@@ -15,6 +15,12 @@ configuration (one env step per transcription interval of the reference):
   and the learner is trained further on all of it (``gradient_steps`` Adam steps on random
   minibatches, the learning rate decaying from ``learning_rate`` to a tenth in each round).
 
+With ``expert_noise`` sigma > 0 the expert's actions are played with Gaussian noise of standard
+deviation sigma (a fraction of the action bound) added to their continuous components and
+clipped to the bound, while the labels stay the expert's own: DART (M. Laskey, J. Lee, R. Fox,
+A. Dragan, K. Goldberg, "DART: Noise Injection for Robust Imitation Learning", CoRL 2017), which
+visits the states around the expert's own episodes from which it corrects.
+
 After each round the learner plays ``validation`` perturbed starts alone (the same starts every
 round); the round whose learner succeeds most often, and among those the one with the lowest mean
 cost (time or effort) over its successes (the later one on a tie), is the policy returned:
@@ -99,6 +105,8 @@ class DAggerSettings:
         validation_scales: the same range for the validation starts; None: ``start_scales``.
         observe_time: the learner also sees the normalized elapsed time
             (``baselines.time_input``), as a time-indexed expert does.
+        expert_noise: standard deviation of the Gaussian noise on the expert's played
+            continuous actions, a fraction of their bound (0: none; DART).
     """
 
     rounds: int = 6
@@ -112,6 +120,7 @@ class DAggerSettings:
     start_scales: tuple[float, float] = (0.01, 0.1)
     validation_scales: tuple[float, float] | None = None
     observe_time: bool = False
+    expert_noise: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("gradient_steps", "batch_size", "episodes", "validation"):
@@ -126,6 +135,8 @@ class DAggerSettings:
             if scales is not None and not 0.0 < scales[0] <= scales[1]:
                 raise ValueError(f"{name} must be (low, high) with 0 < low <= high, "
                                  f"got {scales}")
+        if not 0.0 <= self.expert_noise <= 1.0:
+            raise ValueError(f"expert_noise must be in [0, 1], got {self.expert_noise}")
         if self.learning_rate <= 0.0 or not self.net_arch or min(self.net_arch) < 1:
             raise ValueError(f"need learning_rate > 0 and a non-empty net_arch of positive "
                              f"widths, got {self.learning_rate} and {self.net_arch}")
@@ -187,6 +198,19 @@ def native_action(flat: np.ndarray, hybrid: bool) -> Any:
     from baselines.hybrid_ppo import to_hybrid_actions
 
     return to_hybrid_actions(flat, 2) if hybrid else flat
+
+
+def noisy(label: np.ndarray, sigma: float, hybrid: bool, rng: np.random.Generator) -> np.ndarray:
+    """A flat expert label with N(0, sigma^2) noise on its continuous part, clipped to [-1, 1].
+
+    ``label``: (a,) as ``expert_label`` returns it; the hybrid label's brake choice (its first
+    entry) is kept.
+    """
+    played = label.copy()
+    continuous = slice(1, None) if hybrid else slice(None)
+    played[continuous] = np.clip(played[continuous] + sigma * rng.standard_normal(
+        played[continuous].shape), -1.0, 1.0)
+    return played.astype(np.float32)
 
 
 def learner_env_kwargs(env_id: str, expert: Controller) -> dict[str, Any]:
@@ -254,11 +278,12 @@ class _Labels:
 
 def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, learner: Any,
                   beta: float, seed: int, rng: np.random.Generator, labels: _Labels,
-                  observe_time: bool = False) -> bool:  # fmt: skip
+                  observe_time: bool = False, expert_noise: float = 0.0) -> bool:  # fmt: skip
     """One episode of the beta-mixture from ``reset(seed=seed)``, every state labelled.
 
     At each step the expert is called (its action is the label); the action played is the
-    expert's with probability ``beta`` and the learner's deterministic one otherwise.
+    expert's with probability ``beta`` (with ``noisy``'s noise when ``expert_noise`` > 0) and
+    the learner's deterministic one otherwise.
     ``env_kwargs`` include the start noise. The learner's inputs (the labelled data) are the
     observations, with the elapsed time appended if ``observe_time``. Returns whether the
     episode ended at the goal.
@@ -284,11 +309,11 @@ def play_labelled(env_id: str, env_kwargs: dict[str, Any], expert: Controller, l
         labels.actions.append(label)
         steps += 1
         if rng.random() < beta:
-            flat = label
+            flat = noisy(label, expert_noise, hybrid, rng) if expert_noise > 0.0 else label
         else:
             flat = learner.policy.predict(learner_input, deterministic=True)[0]
-            if hasattr(policy, "applied"):  # an expert whose state follows the torques played
-                policy.applied(flat)
+        if flat is not label and hasattr(policy, "applied"):
+            policy.applied(flat)  # an expert whose state follows the torques played
         observation, reward, terminated, truncated, info = env.step(native_action(flat, hybrid))
         done = terminated or truncated
         for key, value in (("observations", observation), ("actions", action),
@@ -392,7 +417,8 @@ def dagger(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerSe
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             reached = [play_labelled(env_id, {**env_kwargs, "reset_noise_scale": scale}, controller,
-                                     model, beta, reset_seed, rng, labels, settings.observe_time)
+                                     model, beta, reset_seed, rng, labels, settings.observe_time,
+                                     settings.expert_noise)
                        for scale, reset_seed in starts + perturbed_starts(rng, settings.episodes,
                                                                            settings.start_scales)]
             if model is None:
@@ -519,7 +545,8 @@ def distill(env_id: str, expert: str = "lqr", settings: DAggerSettings = DAggerS
                 f"{settings.validation}"
                 + (" --validation-scales {} {}".format(*settings.validation_scales)
                    if settings.validation_scales else "")
-                + (" --observe-time" if settings.observe_time else ""))
+                + (" --observe-time" if settings.observe_time else "")
+                + (f" --expert-noise {settings.expert_noise}" if settings.expert_noise else ""))
     write_record(output / f"{stem}.json", training, distillation=record)
     return output / f"{stem}.zip"
 
@@ -554,6 +581,10 @@ def add_distill_parser(subparsers: Any) -> argparse.ArgumentParser:
     parser.add_argument("--observe-time", action="store_true",
                         help="the learner also sees the normalized elapsed time (for a "
                              "time-indexed expert)")
+    parser.add_argument("--expert-noise", type=float, default=defaults.expert_noise,
+                        metavar="SIGMA",
+                        help="Gaussian noise on the expert's played actions, a fraction of the "
+                             "bound; the labels stay clean (DART; default: %(default)s)")
     parser.add_argument("--output", type=Path, default=DEFAULT_OUTPUT)
     parser.add_argument("--dataset", action="store_true",
                         help="also write each seed's labelled episodes as the Minari dataset "
@@ -577,7 +608,8 @@ def run_distill(args: argparse.Namespace) -> int:
                                    validation=args.validation,
                                    validation_scales=(None if args.validation_scales is None
                                                       else tuple(args.validation_scales)),
-                                   observe_time=args.observe_time)
+                                   observe_time=args.observe_time,
+                                   expert_noise=args.expert_noise)
         for seed in args.seeds:
             stem = run_name(args.env_id, OBJECTIVES.get(args.env_id, ("",))[0], ALGO, seed)
             if (args.output / f"{stem}.json").exists():
@@ -596,7 +628,7 @@ def run_distill(args: argparse.Namespace) -> int:
 __all__ = [
     "ALGO", "DEFAULT_OUTPUT", "FIRST_TRAINING_SEED", "DAgger",
     "DAggerSettings", "Distillation", "Standardized", "add_distill_parser", "dagger", "distill",
-    "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs",
-    "make_learner", "native_action", "perturbed_starts", "play_labelled", "validation_cost",
+    "expert_label", "imitation_loss", "is_hybrid", "learner_env_kwargs", "make_learner",
+    "native_action", "noisy", "perturbed_starts", "play_labelled", "validation_cost",
     "validation_rank", "write_labels",
 ]

@@ -28,6 +28,7 @@ from baselines.distill import (  # noqa: E402
     learner_env_kwargs,
     make_learner,
     native_action,
+    noisy,
     perturbed_starts,
     play_labelled,
     validation_cost,
@@ -160,6 +161,31 @@ def test_the_hybrid_label_plays_exactly_the_experts_box_action() -> None:
     np.testing.assert_array_equal(expert_label(np.array([0.5, -1.0]), hybrid=False), [0.5, -1.0])
 
 
+def test_expert_noise_perturbs_the_played_actions_and_keeps_the_labels() -> None:
+    rng = np.random.default_rng(0)
+    labels = np.tile(np.array([1.0, 0.9], dtype=np.float32), (4000, 1))
+    played = np.array([noisy(label, 0.2, True, rng) for label in labels])
+    assert np.all(played[:, 0] == 1.0)  # the brake choice is kept
+    assert played[:, 1].max() == 1.0 and np.mean(played[:, 1] == 1.0) == pytest.approx(
+        0.31, abs=0.03)  # clipped at the bound: P(N(0, 0.2^2) > 0.1) = 0.31
+    box = np.array([noisy(np.zeros(2, np.float32), 0.2, False, rng) for _ in range(4000)])
+    assert box.std(axis=0) == pytest.approx([0.2, 0.2], rel=0.05)
+
+    expert = lqr_controller(DIFF_DRIVE_EFFORT_V1, "effort")
+    assert expert is not None
+    kwargs = {**learner_env_kwargs(DIFF_DRIVE_EFFORT_V1, expert), "reset_noise_scale": 0.01}
+    clean, perturbed = _Labels([], []), _Labels([], [])
+    play_labelled(DIFF_DRIVE_EFFORT_V1, kwargs, expert, None, 1.0, 3, np.random.default_rng(0),
+                  clean)  # fmt: skip
+    play_labelled(DIFF_DRIVE_EFFORT_V1, kwargs, expert, None, 1.0, 3, np.random.default_rng(0),
+                  perturbed, expert_noise=0.3)  # fmt: skip
+    np.testing.assert_array_equal(clean.observations[0], perturbed.observations[0])
+    assert not np.allclose(clean.observations[5], perturbed.observations[5])  # other states
+    # and every state of the noisy episode is labelled with the expert's own action there
+    episode = perturbed.episodes[0]
+    np.testing.assert_array_equal(np.array(episode["actions"]), np.array(perturbed.actions))
+
+
 def test_the_best_round_succeeds_most_and_then_costs_least() -> None:
     def episode(success: bool, time: float, effort: float) -> Episode:
         return Episode(0, success, time, effort, 0, 0.0)
@@ -198,6 +224,8 @@ def test_bad_requests_are_errors(tmp_path: Path) -> None:
         DAggerSettings(start_scales=(0.0, 0.1))
     with pytest.raises(ValueError, match="validation_scales must be"):
         DAggerSettings(validation_scales=(0.3, 0.1))
+    with pytest.raises(ValueError, match="expert_noise must be in"):
+        DAggerSettings(expert_noise=-0.1)
     with pytest.raises(ValueError, match="shape"):
         expert_label(np.zeros(3), hybrid=True)
     parser = argparse.ArgumentParser()
