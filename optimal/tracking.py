@@ -48,8 +48,8 @@ start's own optimum, which tracking the reference misses by up to 3 % of the eff
 A time-optimal plan that arrives d steps later begins d intervals before the reference's first:
 the controller's intervals start with ``MAX_EXTRA_STEPS`` copies of the reference's first one
 (as ``Plan.delayed``), used only when such a plan is taken, whose own points and multipliers
-then start their windows. The re-solve costs up to 31 s of CPU time at the first step on the
-time task, 4.6 s on the effort task (``mdi-envs bench control``).
+then start their windows. The re-solve costs up to 18 s of CPU time at the first step on the
+time task, 2.1 s on the effort task (``mdi-envs bench control``).
 
 One NLP per distinct window pattern is built in the constructor with the start, the reference
 window and P as parameters, and wrapped once as a CasADi function of (parameters, primal and
