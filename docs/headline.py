@@ -46,16 +46,25 @@ def ordered(rows: Sequence[Row]) -> list[Row]:
     return sorted(rows, key=rank)
 
 
+NOT_PLAYED = Estimate(n=0, missing=0, mean=None, iqm=None, ci=None, values=[])
+"""The scores of a row not played under a condition (shown as "n/a")."""
+
+
 def _scores(study: Study, row: Row, condition: str) -> tuple[Estimate, Estimate]:
-    """The row's success rate and its ratio to the optimum (time or effort, the objective's)."""
+    """The row's success rate and its ratio to the optimum (time or effort, the objective's).
+
+    ``NOT_PLAYED`` twice where the row has no run under ``condition``.
+    """
     aggregate = row.aggregate(condition)
     if aggregate is None:
-        raise ValueError(f"{study.name}: row {row.label!r} has no aggregate at {condition!r}")
+        return NOT_PLAYED, NOT_PLAYED
     return aggregate.success_rate, getattr(aggregate, f"{study.objective}_ratio")
 
 
 def _text(row: Row, estimate: Estimate, percent: bool = False) -> str:
     """IQM [CI] over a trained row's runs; an untrained controller's one value alone."""
+    if estimate is NOT_PLAYED:
+        return "n/a"
     if row.trained or estimate.iqm is None:
         return interval_text(estimate, percent)
     return f"{100 * estimate.iqm:.0f} %" if percent else f"{estimate.iqm:.2f}"

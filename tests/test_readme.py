@@ -30,6 +30,20 @@ def test_results_table_is_generated_from_the_comparison_json() -> None:
     assert "-v1 " in table and "-v0 " not in table and "noise 0.1" in table
 
 
+def test_the_docs_table_marks_rows_not_played_at_a_scale() -> None:
+    """The results page's table holds every study; a row without runs at a scale reads n/a."""
+    sys.path.insert(0, str(ROOT / "docs"))
+    try:
+        import headline
+    finally:
+        sys.path.remove(str(ROOT / "docs"))
+    frame = headline.headline_frame(headline.comparisons())
+    shrinking = frame[frame["controller"] == "MPC (shrinking horizon)"]
+    assert len(shrinking) and set(shrinking["success, noise 0.1"]) == {"n/a"}
+    assert "n/a" not in set(shrinking["success, noise 0.01"])
+    assert {"-v0", "-v1"} <= {env[-3:] for env in frame["env"]}
+
+
 @pytest.mark.slow
 def test_example_runs(capsys: pytest.CaptureFixture[str]) -> None:
     """The example block with a tiny training budget (one PPO rollout of 64 steps)."""
