@@ -206,11 +206,10 @@ def noisy(label: np.ndarray, sigma: float, hybrid: bool, rng: np.random.Generato
     ``label``: (a,) as ``expert_label`` returns it; the hybrid label's brake choice (its first
     entry) is kept.
     """
-    played = label.copy()
-    continuous = slice(1, None) if hybrid else slice(None)
-    played[continuous] = np.clip(played[continuous] + sigma * rng.standard_normal(
-        played[continuous].shape), -1.0, 1.0)
-    return played.astype(np.float32)
+    played = np.array(label, dtype=np.float32)
+    continuous = played[1:] if hybrid else played
+    continuous[:] = np.clip(continuous + sigma * rng.standard_normal(continuous.shape), -1.0, 1.0)
+    return played
 
 
 def learner_env_kwargs(env_id: str, expert: Controller) -> dict[str, Any]:

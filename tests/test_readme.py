@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 import sys
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -18,12 +19,18 @@ def _section(title: str) -> str:
     return text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0]
 
 
-def test_results_table_is_generated_from_the_comparison_json() -> None:
+def _headline() -> ModuleType:
+    """``docs/headline.py`` as a module (the docs folder is not a package)."""
     sys.path.insert(0, str(ROOT / "docs"))
     try:
         import headline
     finally:
         sys.path.remove(str(ROOT / "docs"))
+    return headline
+
+
+def test_results_table_is_generated_from_the_comparison_json() -> None:
+    headline = _headline()
     studies = headline.current(headline.comparisons())
     table = headline.headline_frame(studies).to_markdown(index=False)
     assert table in _section("Results")
@@ -32,11 +39,7 @@ def test_results_table_is_generated_from_the_comparison_json() -> None:
 
 def test_the_docs_table_marks_rows_not_played_at_a_scale() -> None:
     """The results page's table holds every study; a row without runs at a scale reads n/a."""
-    sys.path.insert(0, str(ROOT / "docs"))
-    try:
-        import headline
-    finally:
-        sys.path.remove(str(ROOT / "docs"))
+    headline = _headline()
     frame = headline.headline_frame(headline.comparisons())
     shrinking = frame[frame["controller"] == "MPC (shrinking horizon)"]
     assert len(shrinking) and set(shrinking["success, noise 0.1"]) == {"n/a"}
